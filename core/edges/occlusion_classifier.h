@@ -1,0 +1,53 @@
+// Occlusion classifier (ALGORITHM.md §3.4 steps 4-5): one sample per pair of adjacent
+// superpixels, features of the pair and its shared boundary, a random forest trained from the
+// masks; its probability is painted onto the boundary pixels as the occlusion edge map.
+// The untrained fallback scores a boundary by its mean Ê, rescaled to [0,1] per image.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/base/status.h"
+#include "core/edges/sticky_superpixels.h"
+#include "core/forest/random_forest.h"
+
+namespace tod {
+
+struct OcclusionParams {
+  float floor = 0.01f;  // minimum painted value on a boundary pixel
+  ForestParams forest{.num_trees = 100, .max_features = 0, .min_leaf_size = 5};
+  double max_void_fraction = 0.5;  // skip training pairs with a side more void than this
+};
+
+struct OcclusionTrainingFrame {
+  cv::Mat3b image;          // R1 crop
+  cv::Mat1f enhanced_edge;  // Ê on the crop
+  Superpixels superpixels;
+  cv::Mat1i labels;         // -1 ignore, 0 background, 1 road, >= 2 obstacle instance
+};
+
+class OcclusionClassifier {
+ public:
+  // Untrained: mean-Ê boundary strength (fallback).
+  OcclusionClassifier() = default;
+  static OcclusionClassifier Train(const std::vector<OcclusionTrainingFrame>& frames,
+                                   const OcclusionParams& params);
+  bool trained() const { return !forest_.empty(); }
+
+  // Occlusion edge map on the crop: boundary pixels carry the max pair probability (>= floor),
+  // all other pixels 0.
+  cv::Mat1f Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
+                  const Superpixels& superpixels) const;
+
+  Status Save(std::ostream& out) const;
+  static Result<OcclusionClassifier> Load(std::istream& in, const std::string& what);
+
+ private:
+  OcclusionParams params_;
+  RandomForest forest_;
+};
+
+}  // namespace tod

@@ -1,0 +1,25 @@
+// Sticky-edge superpixels (ALGORITHM.md §3.2(1)): a k-means-like label refinement where the cost
+// rewards placing boundaries on strong (enhanced) edges. Our own implementation.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace tod {
+
+struct StickySuperpixelParams {
+  int k = 1024;          // scale: larger k -> larger superpixels
+  float alpha = 0.5f;    // regularity vs data
+  float beta = 0.9f;     // edge vs colour
+  int iterations = 4;    // full-resolution iterations (2x at half resolution)
+};
+
+struct Superpixels {
+  cv::Mat1i labels;  // 0 = 1-pixel boundary between superpixels, 1..count = superpixel id
+  int count = 0;
+};
+
+// bgr: crop; edge: enhanced edge map Ê of the same size (values may exceed 1).
+Superpixels ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat1f& edge,
+                                     const StickySuperpixelParams& params = {});
+
+}  // namespace tod

@@ -1,0 +1,67 @@
+// The trained pipeline, loaded once from a model bundle and shared by every worker: Detect() is
+// const and thread-safe. This is the only header the server and the CLI need.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "core/base/stage_timer.h"
+#include "core/base/status.h"
+#include "core/base/types.h"
+
+namespace tod {
+
+struct DetectOptions {
+  int max_proposals = 100;           // proposals returned (the map always uses all of them)
+  float obstacle_threshold = 0.5f;   // obstacle mask = P > threshold
+  bool want_probability_map = true;
+};
+
+struct Proposal {
+  Box box;
+  float fused = 0.f;  // F = ORDR + beta1 * OBDR (0 when gated out)
+  float ordr = 0.f;
+  float obdr = 0.f;
+};
+
+struct DetectedObstacle {
+  Box box;
+  long long area = 0;  // pixels of the connected component
+  float peak_probability = 0.f;
+  float mean_probability = 0.f;
+};
+
+struct Detection {
+  int width = 0;
+  int height = 0;
+  std::vector<Proposal> proposals;  // descending fused score, at most max_proposals
+  std::vector<DetectedObstacle> obstacles;
+  cv::Mat1f probability;            // image size, [0,1]; empty unless requested
+  StageTimes timings;               // per stage, in pipeline order, milliseconds
+};
+
+struct ModelInfo {
+  std::string name;           // bundle directory name
+  std::string version;        // bundle's own version string
+  int format_version = 0;
+  std::string created;        // ISO 8601
+  std::string trained_on;     // dataset description
+  std::string edge_source;    // "pixel_forest", "gradient", "sed"
+  nlohmann::json manifest;    // the whole manifest
+};
+
+class Detector {
+ public:
+  virtual ~Detector() = default;
+  // Loads and checks a bundle; errors name the file and the problem.
+  static Result<std::shared_ptr<const Detector>> Load(const std::string& model_dir);
+
+  virtual Result<Detection> Detect(const cv::Mat3b& bgr, const DetectOptions& options) const = 0;
+  virtual const ModelInfo& info() const = 0;
+};
+
+}  // namespace tod

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# The one list of Debian 12 packages this project needs.
+#   deploy/deps.sh build     install what building and testing need
+#   deploy/deps.sh runtime   install only the shared libraries the binaries load
+#   deploy/deps.sh --print [build|runtime]   print the list, install nothing
+# Idempotent: packages already present are skipped. Works as root or through sudo.
+set -euo pipefail
+
+BUILD_PACKAGES=(
+  build-essential cmake ninja-build pkg-config git ca-certificates
+  libopencv-dev libopencv-contrib-dev
+  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
+  libeigen3-dev libspdlog-dev libfmt-dev nlohmann-json3-dev libcli11-dev
+  prometheus-cpp-dev libcpp-httplib-dev libmatio-dev
+  libgtest-dev libgmock-dev
+)
+
+RUNTIME_PACKAGES=(
+  ca-certificates tini
+  libopencv-core406 libopencv-imgproc406 libopencv-imgcodecs406 libopencv-ml406
+  libopencv-contrib406
+  libgrpc++1.51 libgrpc29 libprotobuf32
+  libspdlog1.10 libfmt9 libprometheus-cpp-core1.0 libcpp-httplib0.11 libmatio11
+)
+
+usage() {
+  echo "usage: $0 build|runtime|--print [build|runtime]" >&2
+  exit 2
+}
+
+[[ $# -ge 1 ]] || usage
+case "$1" in
+  build) wanted=("${BUILD_PACKAGES[@]}") ;;
+  runtime) wanted=("${RUNTIME_PACKAGES[@]}") ;;
+  --print)
+    case "${2:-build}" in
+      build) printf '%s\n' "${BUILD_PACKAGES[@]}" ;;
+      runtime) printf '%s\n' "${RUNTIME_PACKAGES[@]}" ;;
+      *) usage ;;
+    esac
+    exit 0
+    ;;
+  *) usage ;;
+esac
+
+missing=()
+for pkg in "${wanted[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed'; then
+    missing+=("$pkg")
+  fi
+done
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "deps.sh: all ${#wanted[@]} $1 packages present"
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then
+  command -v sudo >/dev/null || { echo "deps.sh: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  SUDO="sudo"
+fi
+export DEBIAN_FRONTEND=noninteractive
+echo "deps.sh: installing ${#missing[@]} packages: ${missing[*]}"
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
