@@ -6,12 +6,12 @@
 
 #include <iosfwd>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
 #include "core/base/status.h"
+#include "core/edges/edge_channels.h"
 #include "core/forest/random_forest.h"
 
 namespace tod {
@@ -25,31 +25,47 @@ class EdgeSource {
 };
 
 struct GradientEdgeParams {
-  int smooth_radius = 1;        // triangle filter radius before the gradient
+  int smooth_radius = 1;  // triangle filter radius before the gradient
   double normalise_percentile = 0.99;
 };
+// Triangle-smoothed LUV (edge_channels.h), gradient magnitude max over channels, divided by its
+// normalise_percentile value (by the maximum when fewer pixels respond) and clipped to [0,1].
 std::unique_ptr<EdgeSource> CreateGradientEdgeSource(const GradientEdgeParams& params = {});
 
-// Fails with a message naming the file when it cannot be read.
+// Fails with a message naming the file when it cannot be read (kNotFound), is not a FileStorage
+// file, lacks the model fields OpenCV reads, or fails a probe run (kInvalidArgument).
+// Compute() runs single-scale SED at the model's stride (no NMS), as ALGORITHM.md §2.1.
 Result<std::unique_ptr<EdgeSource>> CreateSedEdgeSource(const std::string& model_path);
 
 // Trained pixel classifier: SED-style channels (LUV, gradient magnitude, oriented gradients at
 // two scales) sampled around each pixel; label = within 2 px of a ground-truth boundary.
+// Channels, features and predictions live on the stride-2 grid of edge_channels.h (as SED's
+// stride 2); Compute() upsamples the grid bilinearly to the crop.
 struct PixelEdgeParams {
   int samples_per_frame = 4000;  // balanced positives / negatives
   int boundary_radius = 2;
   ForestParams forest{.num_trees = 8, .max_features = 0, .min_leaf_size = 5, .max_depth = 20};
+  EdgeChannelParams channels;      // stored in the model: Compute() uses the trained values
+  double max_void_fraction = 0.5;  // cells whose 6x6 neighbourhood is more void are not sampled
 };
 
 struct EdgeTrainingFrame {
-  cv::Mat3b image;       // crop
-  cv::Mat1i labels;      // same size: -1 ignore, 0 background, 1 road, >= 2 obstacle instance
+  cv::Mat3b image;   // crop
+  cv::Mat1i labels;  // same size: -1 ignore, 0 background, 1 road, >= 2 obstacle instance
 };
 
 class PixelEdgeClassifier : public EdgeSource {
  public:
+  // Untrained: Compute() gives an all-zero map.
+  PixelEdgeClassifier() = default;
+  // Fails on an empty frame list, a frame whose labels do not match its image, or when the
+  // frames hold no boundary (or no non-boundary) sample.
+  static Result<PixelEdgeClassifier> TryTrain(const std::vector<EdgeTrainingFrame>& frames,
+                                              const PixelEdgeParams& params);
+  // TryTrain, returning an untrained classifier on failure (check trained()).
   static PixelEdgeClassifier Train(const std::vector<EdgeTrainingFrame>& frames,
                                    const PixelEdgeParams& params);
+  bool trained() const { return !forest_.empty(); }
   cv::Mat1f Compute(const cv::Mat3b& bgr) const override;
   std::string kind() const override { return "pixel_forest"; }
   Status Save(std::ostream& out) const;
@@ -57,6 +73,12 @@ class PixelEdgeClassifier : public EdgeSource {
 
  private:
   RandomForest forest_;
+  EdgeChannelParams channel_params_;
 };
+
+// Builds the edge source of a model bundle. kind "gradient": default parameters, `in` unused;
+// "pixel_forest": PixelEdgeClassifier::Load(*in, what); "sed": `what` is the model file path.
+Result<std::unique_ptr<EdgeSource>> LoadEdgeSource(const std::string& kind, std::istream* in,
+                                                   const std::string& what);
 
 }  // namespace tod

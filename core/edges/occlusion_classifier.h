@@ -5,10 +5,9 @@
 #pragma once
 
 #include <iosfwd>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/base/status.h"
 #include "core/edges/sticky_superpixels.h"
@@ -26,21 +25,30 @@ struct OcclusionTrainingFrame {
   cv::Mat3b image;          // R1 crop
   cv::Mat1f enhanced_edge;  // Ê on the crop
   Superpixels superpixels;
-  cv::Mat1i labels;         // -1 ignore, 0 background, 1 road, >= 2 obstacle instance
+  cv::Mat1i labels;  // -1 ignore, 0 background, 1 road, >= 2 obstacle instance
 };
 
 class OcclusionClassifier {
  public:
   // Untrained: mean-Ê boundary strength (fallback).
   OcclusionClassifier() = default;
+  // Invalid input (a frame whose maps disagree in size, no usable pair, bad params) gives an
+  // untrained classifier; use Fit to learn why.
   static OcclusionClassifier Train(const std::vector<OcclusionTrainingFrame>& frames,
                                    const OcclusionParams& params);
+  // As Train, reporting invalid input as a Status naming the frame and field.
+  static Result<OcclusionClassifier> Fit(const std::vector<OcclusionTrainingFrame>& frames,
+                                         const OcclusionParams& params);
   bool trained() const { return !forest_.empty(); }
+  const OcclusionParams& params() const { return params_; }
 
   // Occlusion edge map on the crop: boundary pixels carry the max pair probability (>= floor),
-  // all other pixels 0.
+  // all other pixels 0. Returns an empty map when the inputs disagree in size.
   cv::Mat1f Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
                   const Superpixels& superpixels) const;
+  // As Paint, with the reason when the inputs are rejected.
+  Result<cv::Mat1f> PaintChecked(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
+                                 const Superpixels& superpixels) const;
 
   Status Save(std::ostream& out) const;
   static Result<OcclusionClassifier> Load(std::istream& in, const std::string& what);

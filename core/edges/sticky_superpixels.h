@@ -4,13 +4,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/base/status.h"
+
 namespace tod {
 
 struct StickySuperpixelParams {
-  int k = 1024;          // scale: larger k -> larger superpixels
-  float alpha = 0.5f;    // regularity vs data
-  float beta = 0.9f;     // edge vs colour
-  int iterations = 4;    // full-resolution iterations (2x at half resolution)
+  int k = 1024;        // scale: larger k -> larger superpixels
+  float alpha = 0.5f;  // regularity vs data
+  float beta = 0.9f;   // edge vs colour
+  int iterations = 4;  // full-resolution iterations (2x at half resolution)
 };
 
 struct Superpixels {
@@ -19,7 +21,18 @@ struct Superpixels {
 };
 
 // bgr: crop; edge: enhanced edge map Ê of the same size (values may exceed 1).
+// On invalid input (see ValidateSuperpixelInput) returns an empty Superpixels (count 0, no
+// labels); use ComputeStickySuperpixelsChecked to learn why.
 Superpixels ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat1f& edge,
                                      const StickySuperpixelParams& params = {});
+
+// Same, with the reason when the input is rejected.
+Result<Superpixels> ComputeStickySuperpixelsChecked(const cv::Mat3b& bgr, const cv::Mat1f& edge,
+                                                    const StickySuperpixelParams& params = {});
+
+// Non-empty image, edge map of the same size and finite, k > 0, alpha and beta in [0,1],
+// iterations >= 0.
+Status ValidateSuperpixelInput(const cv::Mat3b& bgr, const cv::Mat1f& edge,
+                               const StickySuperpixelParams& params);
 
 }  // namespace tod

@@ -6,9 +6,9 @@
 
 #include <cstdint>
 #include <iosfwd>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <string>
+#include <vector>
 
 #include "core/base/status.h"
 
@@ -16,43 +16,57 @@ namespace tod {
 
 struct ForestParams {
   int num_trees = 200;
-  int max_features = 6;      // mtry; <= 0 means floor(num_features / 3), at least 1
-  int min_leaf_size = 5;
-  int max_depth = 0;         // 0 = unlimited
+  int max_features = 6;          // mtry; <= 0 means floor(num_features / 3), at least 1
+  int min_leaf_size = 5;         // every leaf holds at least this many bootstrap samples
+  int max_depth = 0;             // 0 = unlimited; the root has depth 0
   double sample_fraction = 1.0;  // bootstrap size as a fraction of the training set
   std::uint64_t seed = 1;
-  int threads = 0;           // 0 = hardware concurrency
+  int threads = 0;  // 0 = hardware concurrency
 };
 
 class RandomForest {
  public:
   RandomForest() = default;
   // features: one row per sample (CV_32F); targets: one per row.
+  // Invalid input (shape mismatch, no rows, non-finite values, bad params) gives an empty forest;
+  // use Fit to learn why.
   static RandomForest Train(const cv::Mat1f& features, const std::vector<float>& targets,
                             const ForestParams& params);
+  // As Train, but reports invalid input as a Status naming the offending field.
+  static Result<RandomForest> Fit(const cv::Mat1f& features, const std::vector<float>& targets,
+                                  const ForestParams& params);
 
+  // row must hold num_features() values. An empty forest predicts 0.
   float Predict(const float* row) const;
+  // One prediction per row; empty when features.cols != num_features() (for a non-empty forest).
   std::vector<float> PredictBatch(const cv::Mat1f& features) const;
 
   int num_features() const { return num_features_; }
   int num_trees() const { return static_cast<int>(tree_roots_.size()); }
   bool empty() const { return tree_roots_.empty(); }
+  // Total node count over all trees (split nodes + leaves).
+  std::int64_t num_nodes() const { return static_cast<std::int64_t>(nodes_.size()); }
+  // Number of leaves of one tree (for tests and diagnostics); 0 for an index out of range.
+  int CountLeaves(int tree) const;
 
   Status Save(std::ostream& out) const;
   // `what` names the source in error messages (e.g. the file path).
   static Result<RandomForest> Load(std::istream& in, const std::string& what);
 
  private:
+  // 12 bytes per node; the two children of a split are adjacent (right = left + 1), so one
+  // index suffices, and children always come after their parent (which is what makes a loaded
+  // forest provably acyclic).
   struct Node {
     std::int32_t feature = -1;  // -1 = leaf
-    float threshold = 0.f;      // go left when x[feature] <= threshold
-    std::int32_t left = -1;     // child indices into nodes_
-    std::int32_t right = -1;
-    float value = 0.f;          // leaf mean
+    float value = 0.f;          // split: threshold (go left when x[feature] <= value); leaf: mean
+    std::int32_t left = -1;     // index into nodes_ of the left child; right child = left + 1
   };
+  friend class ForestTreeBuilder;
+
   int num_features_ = 0;
-  std::vector<Node> nodes_;
-  std::vector<std::int32_t> tree_roots_;
+  std::vector<Node> nodes_;               // all trees, one after another
+  std::vector<std::int32_t> tree_roots_;  // index of each tree's root in nodes_
 };
 
 }  // namespace tod

@@ -3,9 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <vector>
 
-#include <opencv2/core.hpp>
+#include "core/base/status.h"
 
 namespace tod {
 
@@ -17,22 +18,39 @@ struct RocCurve {
 
 class PixelRocAccumulator {
  public:
+  // Thresholds t_i = i / (num_thresholds - 1), i = 0 .. num_thresholds - 1 (as doubles; a
+  // float probability is compared after exact promotion to double). num_thresholds >= 2.
   explicit PixelRocAccumulator(int num_thresholds = 201);
-  // probability in [0,1]; obstacle / road masks 255 = member (ignore = neither).
+  // probability in [0,1]; obstacle / road masks: nonzero (255) = member (ignore = neither).
+  // O(pixels + thresholds). A frame whose masks do not match the probability map in size is
+  // skipped and its error kept in status() (the first such error).
   void Add(const cv::Mat1f& probability, const cv::Mat1b& obstacle, const cv::Mat1b& road);
+  // As Add, but returns the error for a mismatched frame (which is then not counted).
+  Status AddChecked(const cv::Mat1f& probability, const cv::Mat1b& obstacle, const cv::Mat1b& road);
   RocCurve Curve() const;
   std::int64_t obstacle_pixels() const { return obstacle_total_; }
   std::int64_t road_pixels() const { return road_total_; }
+  int num_thresholds() const { return num_thresholds_; }
+  // The threshold with index i, exactly as used for counting.
+  double Threshold(int i) const;
+  // Ok, or the first error met by Add.
+  const Status& status() const { return first_error_; }
 
  private:
+  // Number of thresholds strictly below p, i.e. how many of the t_i satisfy p > t_i.
+  int ThresholdsBelow(float p) const;
+
   int num_thresholds_;
   std::vector<std::int64_t> true_positives_;   // per threshold
   std::vector<std::int64_t> false_positives_;  // per threshold
   std::int64_t obstacle_total_ = 0;
   std::int64_t road_total_ = 0;
+  Status first_error_;
 };
 
 // TPR at a given FPR by linear interpolation of TPR over FPR along the curve sorted by FPR.
+// Points sharing one FPR collapse to their highest TPR (the ROC's upper envelope); an FPR
+// outside the curve's range takes the TPR of the nearest end point. 0 for an empty curve.
 double TprAtFpr(const RocCurve& curve, double fpr);
 
 // The table's operating points: 0.005, 0.010, ..., 0.030.

@@ -4,19 +4,19 @@
 // change, §4.2.6), refinement and NMS. Our own implementation.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
+#include "core/base/status.h"
 #include "core/base/types.h"
 
 namespace tod {
 
 struct EdgeBoxParams {
-  float alpha = 0.65f;           // step / IoU between neighbouring windows
-  float beta = 0.75f;            // NMS IoU
+  float alpha = 0.65f;  // step / IoU between neighbouring windows
+  float beta = 0.75f;   // NMS IoU
   float min_score = 0.01f;
-  int max_boxes = 10000;         // after NMS
+  int max_boxes = 10000;  // after NMS
   float edge_min_mag = 0.1f;
   float edge_merge_thr = 0.5f;
   float cluster_min_mag = 0.5f;
@@ -29,11 +29,30 @@ struct EdgeBoxParams {
   bool refine = true;
 };
 
+// Checks every field (ranges named in the message); ScoreEdgeBoxes returns no boxes for
+// parameters this rejects, so callers should validate configuration once up front.
+Status ValidateEdgeBoxParams(const EdgeBoxParams& params);
+
+// Work counters of one ScoreEdgeBoxes call (for benchmarks and logs).
+struct EdgeBoxStats {
+  long long windows_visited = 0;          // grid windows scored
+  long long windows_past_early_exit = 0;  // grid windows that reached the boundary-affinity walk
+  long long windows_nonzero = 0;          // grid windows with a final score > 0 (then refined)
+  long long scorings = 0;                 // all scorings past the early exit, with refinement
+  long long boxes_out = 0;                // after NMS / max_boxes
+};
+
 // edge_map: the region's occlusion-edge map normalised to max 1 (call NormaliseToMax first).
 // Returns region-relative boxes sorted by score, descending, after NMS.
+// Box convention: Edge Boxes scores the inclusive pixel range [c0, c1] x [r0, r1] (its "w" is
+// c1 - c0); we return the same pixel set as a half-open Box {c0, r0, c1 - c0 + 1, r1 - r0 + 1},
+// so ScoreSingleBox(returned box) reproduces the returned score.
 std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxParams& params);
+std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxParams& params,
+                                      EdgeBoxStats* stats);
 
 // Scores one given box on the map (the same score the sliding window gives, no refinement).
+// The box is clipped to the map; 0 for an empty box, empty map or invalid parameters.
 float ScoreSingleBox(const cv::Mat1f& edge_map, const Box& box, const EdgeBoxParams& params);
 
 // M / max(M) (unchanged when max is 0).

@@ -3,9 +3,8 @@
 // (with slack 20 * i for band i). Derived from training ground truth; switchable.
 #pragma once
 
-#include <vector>
-
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "core/base/types.h"
 

@@ -1,0 +1,42 @@
+// A small synchronous client for tod.v1.ObstacleDiscovery and grpc.health.v1, shared by tod_client
+// and tod_load.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "tod/v1/obstacle_discovery.grpc.pb.h"
+
+namespace tod::client {
+
+class TodGrpcClient {
+ public:
+  // address: "host:port"; plaintext channel sized for large frames and maps.
+  explicit TodGrpcClient(const std::string& address);
+
+  grpc::Status Detect(const tod::v1::DetectRequest& request, tod::v1::DetectResponse* response,
+                      std::optional<std::chrono::milliseconds> timeout = std::nullopt);
+  // Sends every request on one stream (from a writer thread) and calls on_response for each
+  // response as it arrives. Returns the stream's final status.
+  grpc::Status DetectStream(const std::vector<tod::v1::DetectRequest>& requests,
+                            const std::function<void(const tod::v1::DetectResponse&)>& on_response);
+  grpc::Status GetModelInfo(tod::v1::ModelInfo* info,
+                            std::chrono::milliseconds timeout = std::chrono::seconds(10));
+  // Standard health check; service "" is the whole server.
+  grpc::Status Health(const std::string& service, grpc::health::v1::HealthCheckResponse* response,
+                      std::chrono::milliseconds timeout = std::chrono::seconds(5));
+
+ private:
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<tod::v1::ObstacleDiscovery::Stub> stub_;
+  std::unique_ptr<grpc::health::v1::Health::Stub> health_;
+};
+
+}  // namespace tod::client

@@ -1,0 +1,21 @@
+// The `tod` command-line tool: one subcommand a file; each registers its options on the app
+// and runs when selected. Exit codes: 0 ok, 1 failure (message on stderr), 2 usage.
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace tod::cli {
+
+// Adds a subcommand; the returned function runs it after parsing and yields the exit code.
+using Runner = std::function<int()>;
+Runner AddSynthCommand(CLI::App& app);
+Runner AddTrainCommand(CLI::App& app);
+Runner AddDetectCommand(CLI::App& app);
+Runner AddEvalCommand(CLI::App& app);
+
+// Prints "tod: <message>" to stderr and returns 1.
+int Fail(const std::string& message);
+
+}  // namespace tod::cli

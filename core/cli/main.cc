@@ -1,0 +1,38 @@
+// tod: synthesise data, train a model bundle, detect obstacles, evaluate (ALGORITHM.md).
+#include <iostream>
+#include <map>
+
+#include "core/cli/commands.h"
+
+namespace tod::cli {
+
+int Fail(const std::string& message) {
+  std::cerr << "tod: " << message << "\n";
+  return 1;
+}
+
+}  // namespace tod::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"tod: tiny obstacle discovery (occlusion-aware multilayer regression)"};
+  app.require_subcommand(1);
+  std::map<CLI::App*, tod::cli::Runner> runners;
+  auto add = [&](tod::cli::Runner (*adder)(CLI::App&)) {
+    const std::size_t before = app.get_subcommands({}).size();
+    tod::cli::Runner run = adder(app);
+    runners[app.get_subcommands({})[before]] = std::move(run);
+  };
+  add(tod::cli::AddSynthCommand);
+  add(tod::cli::AddTrainCommand);
+  add(tod::cli::AddDetectCommand);
+  add(tod::cli::AddEvalCommand);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  for (auto& [sub, run] : runners)
+    if (sub->parsed()) return run();
+  return 2;
+}

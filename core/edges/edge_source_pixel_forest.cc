@@ -1,0 +1,223 @@
+// "pixel_forest" edge source: the trained base edge map of ALGORITHM.md §3.4, "Preferred
+// pipeline" step 1. Everything (channels, samples, predictions) lives on the stride-2 cell grid
+// of edge_channels.h, as SED evaluates at stride 2; Compute() upsamples bilinearly.
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <istream>
+#include <numeric>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+#include <ostream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/edges/edge_channels.h"
+#include "core/edges/edge_labels.h"
+#include "core/edges/edge_pixel_features.h"
+#include "core/edges/edge_source.h"
+
+namespace tod {
+namespace {
+
+constexpr std::array<char, 8> kMagic = {'T', 'O', 'D', 'P', 'X', 'E', 'D', 'G'};
+constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::int32_t kMaxSmoothRadius = 16;  // sanity bound when loading
+
+// A cell is a positive sample when at least half of its 2x2 pixels are near a boundary.
+constexpr float kPositiveNearFraction = 0.5f;
+
+void WriteU32(std::ostream& out, std::uint32_t value) {
+  const char bytes[4] = {static_cast<char>(value & 0xff), static_cast<char>((value >> 8) & 0xff),
+                         static_cast<char>((value >> 16) & 0xff),
+                         static_cast<char>((value >> 24) & 0xff)};
+  out.write(bytes, 4);
+}
+
+bool ReadU32(std::istream& in, std::uint32_t* value) {
+  unsigned char bytes[4];
+  if (!in.read(reinterpret_cast<char*>(bytes), 4)) return false;
+  *value = static_cast<std::uint32_t>(bytes[0]) | (static_cast<std::uint32_t>(bytes[1]) << 8) |
+           (static_cast<std::uint32_t>(bytes[2]) << 16) |
+           (static_cast<std::uint32_t>(bytes[3]) << 24);
+  return true;
+}
+
+// Picks up to `count` distinct entries of `pool` (partial Fisher-Yates).
+std::vector<int> SampleWithoutReplacement(std::vector<int> pool, std::size_t count,
+                                          std::mt19937_64& rng) {
+  count = std::min(count, pool.size());
+  for (std::size_t i = 0; i < count; ++i) {
+    std::uniform_int_distribution<std::size_t> pick(i, pool.size() - 1);
+    std::swap(pool[i], pool[pick(rng)]);
+  }
+  pool.resize(count);
+  return pool;
+}
+
+Status CheckFrame(const EdgeTrainingFrame& frame, std::size_t index) {
+  const std::string name = "edge training frame " + std::to_string(index);
+  if (frame.image.empty()) return Status::InvalidArgument(name + ": image is empty");
+  if (frame.labels.size() != frame.image.size()) {
+    return Status::InvalidArgument(name + ": labels are " + std::to_string(frame.labels.cols) +
+                                   "x" + std::to_string(frame.labels.rows) + " but the image is " +
+                                   std::to_string(frame.image.cols) + "x" +
+                                   std::to_string(frame.image.rows));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<PixelEdgeClassifier> PixelEdgeClassifier::TryTrain(
+    const std::vector<EdgeTrainingFrame>& frames, const PixelEdgeParams& params) {
+  if (frames.empty()) return Status::InvalidArgument("pixel edge training: no frames");
+  if (params.samples_per_frame < 2) {
+    return Status::InvalidArgument("pixel edge training: samples_per_frame must be >= 2");
+  }
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    if (Status status = CheckFrame(frames[f], f); !status.ok()) return status;
+  }
+  const int num_features = NumPixelFeatures();
+  const std::size_t per_class = static_cast<std::size_t>(params.samples_per_frame / 2);
+  cv::Mat1f features(0, num_features);
+  std::vector<float> targets;
+  std::size_t positives = 0;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    const EdgeTrainingFrame& frame = frames[f];
+    const CellLabels cells = ComputeCellLabels(frame.labels, params.boundary_radius);
+    std::vector<int> positive_cells;
+    std::vector<int> negative_cells;
+    for (int i = 0; i < cells.near_fraction.rows; ++i) {
+      for (int j = 0; j < cells.near_fraction.cols; ++j) {
+        if (cells.void_fraction(i, j) > params.max_void_fraction) continue;
+        const int index = i * cells.near_fraction.cols + j;
+        (cells.near_fraction(i, j) >= kPositiveNearFraction ? positive_cells : negative_cells)
+            .push_back(index);
+      }
+    }
+    // Same number of each class from every frame, so the forest's mean is a balanced probability.
+    const std::size_t count = std::min({per_class, positive_cells.size(), negative_cells.size()});
+    if (count == 0) continue;
+    std::mt19937_64 rng(params.forest.seed * 0x9E3779B97F4A7C15ULL + f);
+    const EdgeChannels channels = ComputeEdgeChannels(frame.image, params.channels);
+    const PixelFeatureExtractor extractor(channels);
+    const int cols = channels.cols();
+    const auto add_samples = [&](std::vector<int> pool, float target) {
+      for (const int index : SampleWithoutReplacement(std::move(pool), count, rng)) {
+        cv::Mat1f row(1, num_features);
+        extractor.Extract(index / cols, index % cols, row.ptr<float>(0));
+        features.push_back(row);
+        targets.push_back(target);
+      }
+    };
+    add_samples(std::move(positive_cells), 1.f);
+    add_samples(std::move(negative_cells), 0.f);
+    positives += count;
+  }
+  if (positives == 0) {
+    return Status::InvalidArgument(
+        "pixel edge training: no frame has both boundary and non-boundary pixels outside void");
+  }
+  PixelEdgeClassifier classifier;
+  classifier.forest_ = RandomForest::Train(features, targets, params.forest);
+  classifier.channel_params_ = params.channels;
+  if (classifier.forest_.empty()) {
+    return Status::Internal("pixel edge training: the forest trainer returned no trees");
+  }
+  return classifier;
+}
+
+PixelEdgeClassifier PixelEdgeClassifier::Train(const std::vector<EdgeTrainingFrame>& frames,
+                                               const PixelEdgeParams& params) {
+  Result<PixelEdgeClassifier> trained = TryTrain(frames, params);
+  return trained.ok() ? std::move(trained).value() : PixelEdgeClassifier();
+}
+
+cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr) const {
+  if (bgr.empty()) return {};
+  if (forest_.empty()) return cv::Mat1f::zeros(bgr.size());
+  const EdgeChannels channels = ComputeEdgeChannels(bgr, channel_params_);
+  cv::Mat1f cell_map(channels.rows(), channels.cols());
+  const PixelFeatureExtractor extractor(channels);
+  cv::parallel_for_(cv::Range(0, channels.rows()), [&](const cv::Range& rows) {
+    cv::Mat1f row_features;
+    for (int i = rows.start; i < rows.end; ++i) {
+      extractor.ExtractRow(i, &row_features);
+      float* out = cell_map.ptr<float>(i);
+      for (int j = 0; j < channels.cols(); ++j)
+        out[j] = forest_.Predict(row_features.ptr<float>(j));
+    }
+  });
+  // Cell (i, j) is centred on full-resolution (2j + 0.5, 2i + 0.5), which is exactly where
+  // INTER_LINEAR's half-pixel convention puts it when doubling the size.
+  cv::Mat1f padded_map;
+  cv::resize(cell_map, padded_map, cv::Size(2 * cell_map.cols, 2 * cell_map.rows), 0, 0,
+             cv::INTER_LINEAR);
+  cv::Mat1f edge = padded_map(cv::Rect(0, 0, bgr.cols, bgr.rows)).clone();
+  cv::min(cv::max(edge, 0.f), 1.f, edge);
+  return edge;
+}
+
+Status PixelEdgeClassifier::Save(std::ostream& out) const {
+  if (forest_.empty()) {
+    return Status::FailedPrecondition("pixel edge classifier: cannot save an untrained model");
+  }
+  out.write(kMagic.data(), kMagic.size());
+  WriteU32(out, kFormatVersion);
+  WriteU32(out, static_cast<std::uint32_t>(kPixelFeatureLayoutVersion));
+  WriteU32(out, static_cast<std::uint32_t>(kNumEdgeChannels));
+  WriteU32(out, static_cast<std::uint32_t>(NumPixelFeatures()));
+  WriteU32(out, static_cast<std::uint32_t>(std::max(channel_params_.image_smooth_radius, 0)));
+  WriteU32(out, static_cast<std::uint32_t>(std::max(channel_params_.channel_smooth_radius, 0)));
+  if (!out) return Status::Internal("pixel edge classifier: writing the header failed");
+  return forest_.Save(out);
+}
+
+Result<PixelEdgeClassifier> PixelEdgeClassifier::Load(std::istream& in, const std::string& what) {
+  const std::string prefix = "pixel edge classifier '" + what + "': ";
+  std::array<char, kMagic.size()> magic{};
+  if (!in.read(magic.data(), magic.size())) {
+    return Status::DataLoss(prefix + "truncated before the end of the magic number");
+  }
+  if (magic != kMagic) {
+    return Status::InvalidArgument(prefix + "not a pixel edge classifier (bad magic number)");
+  }
+  std::array<std::uint32_t, 6> header{};
+  for (std::uint32_t& field : header) {
+    if (!ReadU32(in, &field)) return Status::DataLoss(prefix + "truncated header");
+  }
+  const auto [format, layout, channels, features, image_radius, channel_radius] = header;
+  if (format != kFormatVersion) {
+    return Status::FailedPrecondition(prefix + "format version " + std::to_string(format) +
+                                      ", this build reads " + std::to_string(kFormatVersion));
+  }
+  if (layout != static_cast<std::uint32_t>(kPixelFeatureLayoutVersion) ||
+      channels != static_cast<std::uint32_t>(kNumEdgeChannels) ||
+      features != static_cast<std::uint32_t>(NumPixelFeatures())) {
+    return Status::FailedPrecondition(
+        prefix + "feature layout " + std::to_string(layout) + " with " + std::to_string(channels) +
+        " channels / " + std::to_string(features) + " features, this build uses layout " +
+        std::to_string(kPixelFeatureLayoutVersion) + " with " + std::to_string(kNumEdgeChannels) +
+        " / " + std::to_string(NumPixelFeatures()));
+  }
+  if (image_radius > kMaxSmoothRadius || channel_radius > kMaxSmoothRadius) {
+    return Status::DataLoss(prefix + "smoothing radius out of range (corrupt header)");
+  }
+  Result<RandomForest> forest = RandomForest::Load(in, what);
+  if (!forest.ok()) return forest.status();
+  if (forest->empty() || forest->num_features() != NumPixelFeatures()) {
+    return Status::FailedPrecondition(prefix + "forest has " + std::to_string(forest->num_trees()) +
+                                      " trees over " + std::to_string(forest->num_features()) +
+                                      " features, expected a non-empty forest over " +
+                                      std::to_string(NumPixelFeatures()));
+  }
+  PixelEdgeClassifier classifier;
+  classifier.forest_ = std::move(forest).value();
+  classifier.channel_params_.image_smooth_radius = static_cast<int>(image_radius);
+  classifier.channel_params_.channel_smooth_radius = static_cast<int>(channel_radius);
+  return classifier;
+}
+
+}  // namespace tod

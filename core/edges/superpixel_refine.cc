@@ -1,0 +1,135 @@
+#include "core/edges/superpixel_refine.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+
+namespace tod {
+namespace {
+
+// Running sums of one label, so that means update in O(1) when a pixel moves.
+struct LabelSums {
+  double count = 0.0;
+  double x = 0.0;
+  double y = 0.0;
+  double c0 = 0.0;
+  double c1 = 0.0;
+  double c2 = 0.0;
+
+  void Add(double sign, int px, int py, const float* c) {
+    count += sign;
+    x += sign * px;
+    y += sign * py;
+    c0 += sign * c[0];
+    c1 += sign * c[1];
+    c2 += sign * c[2];
+  }
+};
+
+}  // namespace
+
+StickyWeights StickyWeightsFor(int k, double alpha, double beta) {
+  StickyWeights w;
+  w.size = k * alpha / 1e4;
+  w.position = alpha / 1e4;
+  w.edge = (1.0 - alpha) * beta;
+  w.colour = (1.0 - alpha) * (1.0 - beta);
+  return w;
+}
+
+int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, int iterations,
+                       std::vector<int>& labels) {
+  const int width = image.width;
+  const int height = image.height;
+  if (width <= 0 || height <= 0 || labels.empty()) return 0;
+  const int max_label = *std::max_element(labels.begin(), labels.end());
+  std::vector<LabelSums> sums(static_cast<size_t>(max_label) + 1);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t i = static_cast<size_t>(y) * width + x;
+      sums[labels[i]].Add(1.0, x, y, image.colour + 3 * i);
+    }
+  }
+
+  int sweeps = 0;
+  for (int iter = 0; iter < iterations; ++iter) {
+    ++sweeps;
+    long long moved = 0;
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const size_t i = static_cast<size_t>(y) * width + x;
+        const int own = labels[i];
+        // 4-neighbours in the order left, up, right, down (ties go to the earliest candidate).
+        std::array<int, 4> nb_label;
+        std::array<float, 4> nb_edge;
+        int nb_count = 0;
+        bool on_border = false;
+        auto push = [&](size_t j) {
+          nb_label[nb_count] = labels[j];
+          nb_edge[nb_count] = image.edge[j];
+          on_border |= labels[j] != own;
+          ++nb_count;
+        };
+        if (x > 0) push(i - 1);
+        if (y > 0) push(i - width);
+        if (x + 1 < width) push(i + 1);
+        if (y + 1 < height) push(i + width);
+        if (!on_border) continue;
+
+        const float* c = image.colour + 3 * i;
+        const double px = x;
+        const double py = y;
+        auto cost = [&](int t) {
+          const LabelSums& s = sums[t];
+          // Size counted as if the pixel belonged to t (it already does when t is its own label):
+          // with every pixel its own label initially this is what lets singletons merge.
+          const double n = s.count + (t == own ? 0.0 : 1.0);
+          const double inv = s.count > 0 ? 1.0 / s.count : 0.0;
+          const double dx = px - s.x * inv;
+          const double dy = py - s.y * inv;
+          const double d0 = c[0] - s.c0 * inv;
+          const double d1 = c[1] - s.c1 * inv;
+          const double d2 = c[2] - s.c2 * inv;
+          // e_t: weakest edge among the neighbours that would be across a boundary from the
+          // pixel if it took label t; no such neighbour means no boundary at all, rewarded as
+          // the strongest neighbouring edge.
+          float e_min = std::numeric_limits<float>::max();
+          float e_max = 0.f;
+          for (int k = 0; k < nb_count; ++k) {
+            e_max = std::max(e_max, nb_edge[k]);
+            if (nb_label[k] != t) e_min = std::min(e_min, nb_edge[k]);
+          }
+          const double e_t = e_min == std::numeric_limits<float>::max() ? e_max : e_min;
+          return weights.position * (dx * dx + dy * dy) +
+                 weights.colour * (d0 * d0 + d1 * d1 + d2 * d2) - weights.edge * e_t +
+                 weights.size / n;
+        };
+
+        int best = own;
+        double best_cost = cost(own);
+        for (int k = 0; k < nb_count; ++k) {
+          const int t = nb_label[k];
+          if (t == own || t == best) continue;
+          bool seen = false;
+          for (int m = 0; m < k; ++m) seen |= nb_label[m] == t;
+          if (seen) continue;
+          const double ct = cost(t);
+          if (ct < best_cost) {
+            best_cost = ct;
+            best = t;
+          }
+        }
+        if (best != own) {
+          sums[own].Add(-1.0, x, y, c);
+          sums[best].Add(1.0, x, y, c);
+          labels[i] = best;
+          ++moved;
+        }
+      }
+    }
+    if (moved == 0) break;
+  }
+  return sweeps;
+}
+
+}  // namespace tod

@@ -1,0 +1,209 @@
+#include "core/features/sample_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace tod {
+namespace {
+
+// Uniform integer in [0, n) by rejection, so the draws are the same on every standard library
+// (std::uniform_int_distribution and std::shuffle are implementation-defined).
+std::uint64_t UniformBelow(std::mt19937_64& rng, std::uint64_t n) {
+  const std::uint64_t limit = std::mt19937_64::max() - std::mt19937_64::max() % n;
+  std::uint64_t draw;
+  do {
+    draw = rng();
+  } while (draw >= limit);
+  return draw % n;
+}
+
+// `count` distinct elements of `pool`, uniformly at random (partial Fisher-Yates).
+std::vector<int> DrawWithoutReplacement(std::vector<int> pool, std::size_t count,
+                                        std::mt19937_64& rng) {
+  count = std::min(count, pool.size());
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t j = i + UniformBelow(rng, pool.size() - i);
+    std::swap(pool[i], pool[j]);
+  }
+  pool.resize(count);
+  return pool;
+}
+
+// n negatives: round(tau_l * n) from the hard pool, the rest from the easy pool, each topped up
+// from the other when short (§6.2 [R]); fewer when both pools together hold fewer than n.
+std::vector<int> DrawNegatives(const std::vector<int>& hard, const std::vector<int>& easy, int n,
+                               double hard_fraction, std::mt19937_64& rng) {
+  const std::size_t wanted = static_cast<std::size_t>(std::max(0, n));
+  const std::size_t hard_wanted =
+      std::min(wanted, static_cast<std::size_t>(std::lround(hard_fraction * wanted)));
+  std::size_t take_hard = std::min(hard_wanted, hard.size());
+  std::size_t take_easy = std::min(wanted - hard_wanted, easy.size());
+  std::size_t missing = wanted - take_hard - take_easy;
+  const std::size_t extra_hard = std::min(missing, hard.size() - take_hard);
+  take_hard += extra_hard;
+  missing -= extra_hard;
+  take_easy += std::min(missing, easy.size() - take_easy);
+
+  std::vector<int> drawn = DrawWithoutReplacement(hard, take_hard, rng);
+  const std::vector<int> easy_drawn = DrawWithoutReplacement(easy, take_easy, rng);
+  drawn.insert(drawn.end(), easy_drawn.begin(), easy_drawn.end());
+  return drawn;
+}
+
+Status ValidateSelectionInput(const Sample& gt, const std::vector<int>& range_limits,
+                              const SampleSelectionParams& params) {
+  const std::string where = "SelectTrainingSamples(sample '" + gt.name + "'): ";
+  if (range_limits.size() < 2) {
+    return Status::InvalidArgument(where + "range_limits needs K + 1 >= 2 row limits, got " +
+                                   std::to_string(range_limits.size()));
+  }
+  for (std::size_t i = 1; i < range_limits.size(); ++i) {
+    if (range_limits[i] >= range_limits[i - 1]) {
+      return Status::InvalidArgument(where +
+                                     "range_limits must be strictly decreasing (y_1 > "
+                                     "... > y_{K+1}), but entry " +
+                                     std::to_string(i) + " is " + std::to_string(range_limits[i]) +
+                                     " after " + std::to_string(range_limits[i - 1]));
+    }
+  }
+  const std::size_t num_ranges = range_limits.size() - 1;
+  const auto check_counts = [&](const std::vector<int>& counts, const char* field) -> Status {
+    if (counts.size() != num_ranges) {
+      return Status::InvalidArgument(where + "params." + field + " has " +
+                                     std::to_string(counts.size()) + " entries but there are " +
+                                     std::to_string(num_ranges) + " vertical ranges");
+    }
+    if (std::any_of(counts.begin(), counts.end(), [](int c) { return c < 0; })) {
+      return Status::InvalidArgument(where + "params." + field + " has a negative count");
+    }
+    return Status::Ok();
+  };
+  if (Status s = check_counts(params.ordr_negatives, "ordr_negatives"); !s.ok()) return s;
+  if (Status s = check_counts(params.obdr_negatives, "obdr_negatives"); !s.ok()) return s;
+  if (Status s = check_counts(params.positives, "positives"); !s.ok()) return s;
+  if (!(params.hard_fraction >= 0.0 && params.hard_fraction <= 1.0)) {
+    return Status::InvalidArgument(where + "params.hard_fraction must lie in [0, 1]");
+  }
+  if (gt.road.empty()) {
+    return Status::InvalidArgument(where + "the road mask is empty; categories need it");
+  }
+  if (!gt.image.empty() && gt.road.size() != gt.image.size()) {
+    return Status::InvalidArgument(where + "the road mask size differs from the image size");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+ProposalCategory CategorizeProposal(const Box& box, const MaskIoUTable& obstacles,
+                                    const MaskPixelCounter& road,
+                                    const SampleSelectionParams& params) {
+  if (obstacles.MaxIoU(box) >= params.obstacle_iou) return ProposalCategory::kObstacle;
+  const long long area = box.area();
+  if (area > 0 &&
+      static_cast<double>(road.Count(box)) / static_cast<double>(area) > params.road_fraction) {
+    return ProposalCategory::kRoad;
+  }
+  return ProposalCategory::kBackground;
+}
+
+int VerticalRangeIndex(int row, const std::vector<int>& range_limits) {
+  const int num_ranges = static_cast<int>(range_limits.size()) - 1;
+  for (int k = 0; k + 1 < num_ranges; ++k) {
+    if (row > range_limits[k + 1]) return k;  // (y_{k+2}, y_{k+1}] and everything below y_1
+  }
+  return std::max(0, num_ranges - 1);  // the closed top range and everything above it
+}
+
+Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& proposals,
+                                              const Sample& gt,
+                                              const std::vector<int>& range_limits,
+                                              const SampleSelectionParams& params,
+                                              std::uint64_t seed) {
+  if (Status s = ValidateSelectionInput(gt, range_limits, params); !s.ok()) return s;
+  Result<MaskIoUTable> table = MaskIoUTable::Build(gt.instances);
+  if (!table.ok()) {
+    return Status::InvalidArgument("SelectTrainingSamples(sample '" + gt.name +
+                                   "'): " + table.status().message());
+  }
+  const MaskIoUTable& obstacles = *table;
+  const MaskPixelCounter road(gt.road);
+  const int num_proposals = static_cast<int>(proposals.size());
+
+  std::vector<double> max_iou(num_proposals);
+  std::vector<ProposalCategory> category(num_proposals);
+  std::vector<int> range(num_proposals);
+  for (int i = 0; i < num_proposals; ++i) {
+    const Box& box = proposals[i].box;
+    max_iou[i] = obstacles.MaxIoU(box);
+    category[i] = CategorizeProposal(box, obstacles, road, params);
+    range[i] = VerticalRangeIndex(BottomRow(box), range_limits);
+  }
+
+  SelectedSamples out;
+  // Positives: per GT obstacle, the n+_k proposals of all of B^I with the highest IoU to it
+  // (IoU > 0), k = range of the obstacle's bottom; ties keep the lower proposal index.
+  std::vector<char> is_positive(num_proposals, 0);
+  for (int o = 0; o < obstacles.num_instances(); ++o) {
+    const int k = VerticalRangeIndex(BottomRow(gt.instances[o].box), range_limits);
+    std::vector<std::pair<double, int>> overlapping;  // (IoU, proposal index)
+    for (int i = 0; i < num_proposals; ++i) {
+      const double iou = obstacles.IoU(proposals[i].box, o);
+      if (iou > 0.0) overlapping.emplace_back(iou, i);
+    }
+    const std::size_t take =
+        std::min(overlapping.size(), static_cast<std::size_t>(params.positives[k]));
+    std::partial_sort(overlapping.begin(), overlapping.begin() + take, overlapping.end(),
+                      [](const auto& a, const auto& b) {
+                        return a.first != b.first ? a.first > b.first : a.second < b.second;
+                      });
+    for (std::size_t j = 0; j < take; ++j) {
+      const int index = overlapping[j].second;
+      if (!is_positive[index]) {
+        is_positive[index] = 1;
+        out.positive_indices.push_back(index);
+      }
+    }
+  }
+
+  std::mt19937_64 rng(seed);
+  const int num_ranges = static_cast<int>(range_limits.size()) - 1;
+  const auto select_negatives = [&](ProposalCategory wanted, const std::vector<int>& counts) {
+    std::vector<int> negatives;
+    for (int k = 0; k < num_ranges; ++k) {
+      std::vector<int> hard, easy;
+      for (int i = 0; i < num_proposals; ++i) {
+        if (range[i] != k || category[i] != wanted || is_positive[i] ||
+            max_iou[i] >= params.obstacle_iou) {
+          continue;
+        }
+        (proposals[i].score > params.hard_objectness ? hard : easy).push_back(i);
+      }
+      const std::vector<int> drawn =
+          DrawNegatives(hard, easy, counts[k], params.hard_fraction, rng);
+      negatives.insert(negatives.end(), drawn.begin(), drawn.end());
+    }
+    return negatives;
+  };
+
+  const auto target_of = [&](int i) {
+    return static_cast<float>(params.box_iou_target ? obstacles.MaxBoxIoU(proposals[i].box)
+                                                    : max_iou[i]);
+  };
+  const auto assemble = [&](const std::vector<int>& negatives, std::vector<int>& indices,
+                            std::vector<float>& targets) {
+    indices = out.positive_indices;
+    indices.insert(indices.end(), negatives.begin(), negatives.end());
+    targets.reserve(indices.size());
+    for (const int i : indices) targets.push_back(target_of(i));
+  };
+  assemble(select_negatives(ProposalCategory::kRoad, params.ordr_negatives), out.ordr_indices,
+           out.ordr_targets);
+  assemble(select_negatives(ProposalCategory::kBackground, params.obdr_negatives), out.obdr_indices,
+           out.obdr_targets);
+  return out;
+}
+
+}  // namespace tod

@@ -1,0 +1,209 @@
+#include "core/forest/random_forest.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "core/forest/split_mix.h"
+#include "core/forest/tree_builder.h"
+
+namespace tod {
+namespace {
+
+constexpr int kMaxTrees = 1 << 20;
+constexpr long long kMaxRows = 1 << 30;
+constexpr long long kMaxNodes = std::numeric_limits<std::int32_t>::max() - 1;
+constexpr int kPredictBlockRows = 256;
+
+Status ValidateTrainingInput(const cv::Mat1f& features, const std::vector<float>& targets,
+                             const ForestParams& params) {
+  const std::string where = "RandomForest::Fit: ";
+  if (features.empty() || features.rows <= 0 || features.cols <= 0) {
+    return Status::InvalidArgument(where + "features is empty (need at least one row and column)");
+  }
+  if (features.rows > kMaxRows) {
+    return Status::ResourceExhausted(where + "features has " + std::to_string(features.rows) +
+                                     " rows, more than the limit " + std::to_string(kMaxRows));
+  }
+  if (targets.size() != static_cast<std::size_t>(features.rows)) {
+    return Status::InvalidArgument(where + "targets has " + std::to_string(targets.size()) +
+                                   " values but features has " + std::to_string(features.rows) +
+                                   " rows");
+  }
+  for (int r = 0; r < features.rows; ++r) {
+    const float* row = features[r];
+    for (int c = 0; c < features.cols; ++c) {
+      if (!std::isfinite(row[c])) {
+        return Status::InvalidArgument(where + "features(" + std::to_string(r) + ", " +
+                                       std::to_string(c) + ") is not finite");
+      }
+    }
+    if (!std::isfinite(targets[r])) {
+      return Status::InvalidArgument(where + "targets[" + std::to_string(r) + "] is not finite");
+    }
+  }
+  if (params.num_trees < 1 || params.num_trees > kMaxTrees) {
+    return Status::InvalidArgument(where +
+                                   "params.num_trees = " + std::to_string(params.num_trees) +
+                                   " is outside [1, " + std::to_string(kMaxTrees) + "]");
+  }
+  if (params.min_leaf_size < 1) {
+    return Status::InvalidArgument(
+        where + "params.min_leaf_size = " + std::to_string(params.min_leaf_size) + " must be >= 1");
+  }
+  if (params.max_depth < 0) {
+    return Status::InvalidArgument(
+        where + "params.max_depth = " + std::to_string(params.max_depth) + " must be >= 0");
+  }
+  if (params.threads < 0) {
+    return Status::InvalidArgument(where + "params.threads = " + std::to_string(params.threads) +
+                                   " must be >= 0");
+  }
+  const double draws = params.sample_fraction * features.rows;
+  if (!std::isfinite(params.sample_fraction) || params.sample_fraction <= 0.0 ||
+      draws > static_cast<double>(kMaxRows)) {
+    return Status::InvalidArgument(
+        where + "params.sample_fraction = " + std::to_string(params.sample_fraction) +
+        " must be > 0 and give at most " + std::to_string(kMaxRows) + " bootstrap draws");
+  }
+  return Status::Ok();
+}
+
+TreeSettings ResolveSettings(const ForestParams& params, int num_features, int rows) {
+  TreeSettings settings;
+  settings.mtry = params.max_features <= 0 ? std::max(1, num_features / 3)
+                                           : std::min(params.max_features, num_features);
+  settings.min_leaf_size = params.min_leaf_size;
+  settings.max_depth = params.max_depth;
+  settings.bootstrap_size =
+      std::max(1, static_cast<int>(std::llround(params.sample_fraction * rows)));
+  return settings;
+}
+
+// Each tree's stream depends only on (seed, tree index): results do not depend on threading.
+std::uint64_t TreeSeed(std::uint64_t seed, int tree) {
+  return SplitMix64::Mix(SplitMix64::Mix(seed) + 0x9E3779B97F4A7C15ULL * (tree + 1ULL));
+}
+
+int ResolveThreads(int requested, int num_trees) {
+  int threads = requested > 0 ? requested : static_cast<int>(std::thread::hardware_concurrency());
+  return std::clamp(threads, 1, num_trees);
+}
+
+}  // namespace
+
+Result<RandomForest> RandomForest::Fit(const cv::Mat1f& features, const std::vector<float>& targets,
+                                       const ForestParams& params) {
+  if (Status status = ValidateTrainingInput(features, targets, params); !status.ok()) {
+    return status;
+  }
+  const TreeSettings settings = ResolveSettings(params, features.cols, features.rows);
+  const PresortedTrainingSet data = PresortedTrainingSet::Build(features, targets);
+
+  std::vector<std::vector<Node>> trees(params.num_trees);
+  std::atomic<int> next_tree{0};
+  auto worker = [&]() {
+    ForestTreeBuilder builder(data, settings);
+    for (int t = next_tree++; t < params.num_trees; t = next_tree++) {
+      trees[t] = builder.Build(TreeSeed(params.seed, t));
+    }
+  };
+  const int num_threads = ResolveThreads(params.threads, params.num_trees);
+  {
+    std::vector<std::jthread> pool;
+    for (int i = 1; i < num_threads; ++i) pool.emplace_back(worker);
+    worker();
+  }  // jthreads join here
+
+  long long total_nodes = 0;
+  for (const std::vector<Node>& tree : trees) total_nodes += static_cast<long long>(tree.size());
+  if (total_nodes > kMaxNodes) {
+    return Status::ResourceExhausted("RandomForest::Fit: the forest has " +
+                                     std::to_string(total_nodes) + " nodes, more than " +
+                                     std::to_string(kMaxNodes));
+  }
+  RandomForest forest;
+  forest.num_features_ = features.cols;
+  forest.nodes_.reserve(static_cast<std::size_t>(total_nodes));
+  forest.tree_roots_.reserve(trees.size());
+  for (const std::vector<Node>& tree : trees) {
+    const auto offset = static_cast<std::int32_t>(forest.nodes_.size());
+    forest.tree_roots_.push_back(offset);
+    for (Node node : tree) {
+      if (node.feature >= 0) node.left += offset;
+      forest.nodes_.push_back(node);
+    }
+  }
+  return forest;
+}
+
+RandomForest RandomForest::Train(const cv::Mat1f& features, const std::vector<float>& targets,
+                                 const ForestParams& params) {
+  Result<RandomForest> fitted = Fit(features, targets, params);
+  return fitted.ok() ? std::move(fitted).value() : RandomForest();
+}
+
+float RandomForest::Predict(const float* row) const {
+  if (tree_roots_.empty()) return 0.f;
+  double sum = 0.0;
+  for (const std::int32_t root : tree_roots_) {
+    std::int32_t i = root;
+    while (nodes_[i].feature >= 0) {
+      const Node& node = nodes_[i];
+      i = node.left + (row[node.feature] > node.value ? 1 : 0);
+    }
+    sum += nodes_[i].value;
+  }
+  return static_cast<float>(sum / static_cast<double>(tree_roots_.size()));
+}
+
+std::vector<float> RandomForest::PredictBatch(const cv::Mat1f& features) const {
+  if (features.rows <= 0) return {};
+  if (tree_roots_.empty()) return std::vector<float>(features.rows, 0.f);
+  if (features.cols != num_features_) return {};
+  // Blocks of rows walk one tree after another so a tree stays in cache across the block.
+  // Per row the sum runs over trees in the same order as Predict: results are identical.
+  std::vector<float> out(features.rows);
+  std::vector<double> sums(kPredictBlockRows);
+  for (int start = 0; start < features.rows; start += kPredictBlockRows) {
+    const int stop = std::min(features.rows, start + kPredictBlockRows);
+    std::fill(sums.begin(), sums.end(), 0.0);
+    for (const std::int32_t root : tree_roots_) {
+      for (int r = start; r < stop; ++r) {
+        const float* row = features[r];
+        std::int32_t i = root;
+        while (nodes_[i].feature >= 0) {
+          const Node& node = nodes_[i];
+          i = node.left + (row[node.feature] > node.value ? 1 : 0);
+        }
+        sums[r - start] += nodes_[i].value;
+      }
+    }
+    const auto trees = static_cast<double>(tree_roots_.size());
+    for (int r = start; r < stop; ++r) out[r] = static_cast<float>(sums[r - start] / trees);
+  }
+  return out;
+}
+
+int RandomForest::CountLeaves(int tree) const {
+  if (tree < 0 || tree >= num_trees()) return 0;
+  int leaves = 0;
+  std::vector<std::int32_t> stack{tree_roots_[tree]};
+  while (!stack.empty()) {
+    const Node& node = nodes_[stack.back()];
+    stack.pop_back();
+    if (node.feature < 0) {
+      ++leaves;
+    } else {
+      stack.push_back(node.left);
+      stack.push_back(node.left + 1);
+    }
+  }
+  return leaves;
+}
+
+}  // namespace tod

@@ -1,0 +1,29 @@
+#include "core/pipeline/dataset_factory.h"
+
+#include "core/data/laf_reader.h"
+#include "core/modd2/modd2_reader.h"
+
+namespace tod {
+
+Result<std::string> DetectDatasetFormat(const std::string& root) {
+  if (LooksLikeLaf(root)) return std::string("laf");
+  if (LooksLikeModd2(root)) return std::string("modd2");
+  return Status::NotFound(root +
+                          ": neither the Lost and Found layout (leftImg8bit/, gtCoarse/) nor the "
+                          "MODDv2 layout (video_data/, annotationsV2/); use --format");
+}
+
+Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& root, const std::string& split,
+                                             const std::string& format) {
+  std::string chosen = format;
+  if (chosen == "auto") {
+    auto detected = DetectDatasetFormat(root);
+    if (!detected.ok()) return detected.status();
+    chosen = *detected;
+  }
+  if (chosen == "laf") return OpenLafDataset(root, split);
+  if (chosen == "modd2") return OpenModd2Dataset(root, split);
+  return Status::InvalidArgument("unknown dataset format '" + format + "' (auto, laf, modd2)");
+}
+
+}  // namespace tod

@@ -1,0 +1,238 @@
+#include "core/pipeline/evaluator.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <mutex>
+#include <sstream>
+
+#include <opencv2/ximgproc/edgeboxes.hpp>
+
+#include "core/metrics/instance_recall.h"
+#include "core/pipeline/dataset_factory.h"
+#include "core/pipeline/obstacle_detector.h"
+#include "core/pipeline/parallel.h"
+#include "core/proposals/edge_orientation.h"
+
+namespace tod {
+namespace {
+
+constexpr int kMaxProposals = 1000;
+const std::vector<int> kTableN = {200, 400, 600, 800, 1000};
+
+std::vector<Box> BoxesOf(const std::vector<ScoredBox>& boxes) {
+  std::vector<Box> out;
+  out.reserve(boxes.size());
+  for (const auto& b : boxes) out.push_back(b.box);
+  return out;
+}
+
+// The baseline a user would otherwise pick: OpenCV ximgproc Edge Boxes on the same base edge map
+// over R1 (alpha 0.65, beta 0.75, 1000 boxes, OpenCV's other defaults), no size filter.
+std::vector<Box> EdgeBoxesBaseline(const cv::Mat1f& base_edge, const Box& r1) {
+  if (base_edge.empty()) return {};
+  const cv::Mat1f orientation = ComputeEdgeOrientation(base_edge);
+  cv::Ptr<cv::ximgproc::EdgeBoxes> eb = cv::ximgproc::createEdgeBoxes(0.65f, 0.75f);
+  eb->setMaxBoxes(kMaxProposals);
+  std::vector<cv::Rect> rects;
+  eb->getBoundingBoxes(base_edge, orientation, rects);
+  std::vector<Box> out;
+  for (const cv::Rect& r : rects) out.push_back({r.x + r1.x, r.y + r1.y, r.width, r.height});
+  return out;
+}
+
+VariantCurves Curves(const RecallAccumulator& acc) {
+  VariantCurves c;
+  for (int n = 0; n <= kMaxProposals; n += 5) {
+    c.n_grid.push_back(n);
+    c.recall_at_07.push_back(acc.Recall(n, 0.7));
+    c.average_recall.push_back(acc.AverageRecall(n));
+  }
+  for (double tau : RecallIouThresholds()) {
+    c.iou_grid.push_back(tau);
+    c.recall_at_1000.push_back(acc.Recall(kMaxProposals, tau));
+  }
+  for (int n : kTableN) c.ar_table[n] = acc.AverageRecall(n);
+  return c;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+std::string Fixed(double v, int digits = 3) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+}  // namespace
+
+Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options) {
+  auto dataset = OpenDataset(options.data_root, options.split, options.format);
+  if (!dataset.ok()) return dataset.status();
+  const int total = static_cast<int>((*dataset)->size());
+  const int n = options.max_frames > 0 ? std::min(total, options.max_frames) : total;
+  if (n == 0) return Status::InvalidArgument(options.data_root + ": the " + options.split + " split is empty");
+
+  std::map<std::string, RecallAccumulator> recall;
+  for (const auto& v : ProposalVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
+  for (const auto& v : RegressionVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
+  std::map<std::string, PixelRocAccumulator> roc;
+  for (const auto& v : RegressionVariants()) roc.emplace(v, PixelRocAccumulator());
+  std::map<std::string, std::vector<double>> stage_ms;
+  std::vector<std::string> stage_order;
+  std::mutex mutex;
+  std::vector<Status> errors(n);
+  int done = 0;
+
+  ParallelFor(n, options.threads, [&](int i) {
+    auto loaded = (*dataset)->Load(i);
+    if (!loaded.ok()) {
+      errors[i] = loaded.status();
+      return;
+    }
+    const Sample& s = *loaded;
+    const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
+    const int layers = geo.regions.num_layers();
+
+    // Proposal-only variants on the plain (not obstacle-aware) occlusion edges.
+    const OcclusionEdges plain = ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges,
+                                                       &bundle.occlusion, bundle.params.superpixels,
+                                                       /*enhance=*/false);
+    const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1);
+    const ProposalSet olp1 = ProposeBoxes(plain, geo.regions, bundle.params.boxes,
+                                          {1, false, bundle.params.size_filter}, geo.size_filter);
+
+    // The detector's own path (timed): enhanced edges, BP = OAOCC+OLP@4+MS, regression, map.
+    StageTimer timer;
+    const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges,
+                                                       &bundle.occlusion, bundle.params.superpixels,
+                                                       /*enhance=*/true, &timer);
+    ProposalSet bp = ProposeBoxes(oaocc, geo.regions, bundle.params.boxes,
+                                  {layers, true, bundle.params.size_filter}, geo.size_filter);
+    timer.Mark("proposals");
+    std::vector<Box> oaocc1;  // R1 boxes are the same with and without MS (factor 1 in R1)
+    for (std::size_t j = 0; j < bp.boxes.size(); ++j)
+      if (bp.layer[j] == 0) oaocc1.push_back(bp.boxes[j].box);
+    const std::vector<Box> bp_boxes = BoxesOf(bp.boxes);
+    const RegressedProposals bp_reg = RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(bp), &timer);
+    const std::vector<float> fused = FuseScores(bp_reg.ordr, bp_reg.obdr, bundle.params.fusion);
+    std::vector<ScoredBox> bp_fusion(fused.size()), bp_ordr(fused.size());
+    for (std::size_t j = 0; j < fused.size(); ++j) {
+      bp_fusion[j] = {bp_reg.proposals.boxes[j].box, fused[j]};
+      bp_ordr[j] = {bp_reg.proposals.boxes[j].box, bp_reg.ordr[j]};
+    }
+    const cv::Mat1f map_fusion = AccumulateProbabilityMap(bp_fusion, s.image.size(), bundle.params.probability_map);
+    timer.Mark("probability_map");
+
+    ProposalSet op = ProposeBoxes(oaocc, geo.regions, bundle.params.boxes,
+                                  {layers, false, bundle.params.size_filter}, geo.size_filter);
+    const std::vector<Box> op_boxes = BoxesOf(op.boxes);
+    const RegressedProposals op_reg = RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(op));
+    std::vector<ScoredBox> op_ordr(op_reg.ordr.size());
+    for (std::size_t j = 0; j < op_ordr.size(); ++j) op_ordr[j] = {op_reg.proposals.boxes[j].box, op_reg.ordr[j]};
+    const cv::Mat1f map_bp_ordr = AccumulateProbabilityMap(bp_ordr, s.image.size(), bundle.params.probability_map);
+    const cv::Mat1f map_op_ordr = AccumulateProbabilityMap(op_ordr, s.image.size(), bundle.params.probability_map);
+    const float min_score = bundle.params.probability_map.min_score;
+
+    std::vector<Box> gt;
+    for (const auto& inst : s.instances) gt.push_back(inst.box);
+    std::lock_guard lock(mutex);
+    recall.at("EB").Add(eb, gt);
+    recall.at("OLP@1").Add(BoxesOf(olp1.boxes), gt);
+    recall.at("OAOCC+OLP@1").Add(oaocc1, gt);
+    recall.at("OAOCC+OLP@4").Add(op_boxes, gt);
+    recall.at("OAOCC+OLP@4+MS").Add(bp_boxes, gt);
+    recall.at("OP+ORDR@4").Add(BoxesOf(RankedAboveThreshold(op_ordr, min_score)), gt);
+    recall.at("BP+ORDR@4").Add(BoxesOf(RankedAboveThreshold(bp_ordr, min_score)), gt);
+    recall.at("BP+Fusion@4").Add(BoxesOf(RankedAboveThreshold(bp_fusion, min_score)), gt);
+    roc.at("OP+ORDR@4").Add(map_op_ordr, s.obstacle, s.road);
+    roc.at("BP+ORDR@4").Add(map_bp_ordr, s.obstacle, s.road);
+    roc.at("BP+Fusion@4").Add(map_fusion, s.obstacle, s.road);
+    for (const auto& [stage, ms] : timer.times()) {
+      if (!stage_ms.count(stage)) stage_order.push_back(stage);
+      stage_ms[stage].push_back(ms);
+    }
+    stage_ms["total"].push_back(timer.total_ms());
+    ++done;
+    if (options.progress && (done % 10 == 0 || done == n))
+      options.progress("evaluated " + std::to_string(done) + "/" + std::to_string(n) + " frames");
+  });
+  for (const Status& e : errors)
+    if (!e.ok()) return e;
+
+  EvalReport report;
+  report.frames = n;
+  report.instances = recall.at("EB").instances();
+  for (const auto& v : ProposalVariants()) report.proposals[v] = Curves(recall.at(v));
+  for (const auto& v : RegressionVariants()) {
+    report.regression[v] = Curves(recall.at(v));
+    report.roc[v] = roc.at(v).Curve();
+    for (double fpr : TableFprs()) report.tpr_at_fpr[v][fpr] = TprAtFpr(report.roc[v], fpr);
+  }
+  stage_order.push_back("total");
+  for (const auto& stage : stage_order) report.stage_median_ms.emplace_back(stage, Median(stage_ms[stage]));
+  return report;
+}
+
+nlohmann::json EvalReportToJson(const EvalReport& r) {
+  nlohmann::json j;
+  j["frames"] = r.frames;
+  j["instances"] = r.instances;
+  auto ar = [](const VariantCurves& c) {
+    nlohmann::json a = nlohmann::json::object();
+    for (const auto& [n, v] : c.ar_table) a[std::to_string(n)] = v;
+    return a;
+  };
+  j["proposals"] = nlohmann::json::object();
+  for (const auto& v : ProposalVariants()) j["proposals"][v] = {{"ar", ar(r.proposals.at(v))}};
+  j["regression"] = nlohmann::json::object();
+  for (const auto& v : RegressionVariants()) {
+    nlohmann::json tpr = nlohmann::json::object();
+    for (const auto& [fpr, t] : r.tpr_at_fpr.at(v)) tpr[Fixed(fpr)] = t;
+    j["regression"][v] = {{"tpr_at_fpr", tpr}, {"ar", ar(r.regression.at(v))}};
+  }
+  j["timing_ms"] = nlohmann::json::object();
+  for (const auto& [stage, ms] : r.stage_median_ms) j["timing_ms"][stage] = ms;
+  return j;
+}
+
+std::string FormatEvalTables(const EvalReport& r) {
+  std::ostringstream o;
+  o << "frames " << r.frames << ", obstacle instances " << r.instances << "\n\n";
+  o << "Average recall (proposals)\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%-16s %7s %7s %7s %7s %7s\n", "variant", "200", "400", "600", "800", "1000");
+  o << line;
+  auto ar_row = [&](const std::string& name, const VariantCurves& c) {
+    std::snprintf(line, sizeof line, "%-16s", name.c_str());
+    o << line;
+    for (int n : kTableN) o << " " << std::string(7 - Fixed(c.ar_table.at(n)).size(), ' ') << Fixed(c.ar_table.at(n));
+    o << "\n";
+  };
+  for (const auto& v : ProposalVariants()) ar_row(v, r.proposals.at(v));
+  o << "\nPixel ROC: TPR at FPR (regression)\n";
+  std::snprintf(line, sizeof line, "%-16s", "variant");
+  o << line;
+  for (double f : TableFprs()) o << "   " << Fixed(f);
+  o << "\n";
+  for (const auto& v : RegressionVariants()) {
+    std::snprintf(line, sizeof line, "%-16s", v.c_str());
+    o << line;
+    for (double f : TableFprs()) o << "   " << Fixed(r.tpr_at_fpr.at(v).at(f));
+    o << "\n";
+  }
+  o << "\nAverage recall (regressed, score > 0.25)\n";
+  for (const auto& v : RegressionVariants()) ar_row(v, r.regression.at(v));
+  o << "\nMedian time per frame (ms)\n";
+  for (const auto& [stage, ms] : r.stage_median_ms) {
+    std::snprintf(line, sizeof line, "%-16s %9.1f\n", stage.c_str(), ms);
+    o << line;
+  }
+  return o.str();
+}
+
+}  // namespace tod

@@ -1,0 +1,65 @@
+// `tod eval`: the paper's two tables on a dataset split (ALGORITHM.md §8) for the variants
+//   proposals:  EB, OLP@1, OAOCC+OLP@1, OAOCC+OLP@4, OAOCC+OLP@4+MS   (average recall)
+//   regression: OP+ORDR@4, BP+ORDR@4, BP+Fusion@4   (TPR at FPR, average recall)
+// plus the median time of each stage per frame.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/metrics/pixel_roc.h"
+#include "core/pipeline/model_bundle.h"
+
+namespace tod {
+
+struct EvalOptions {
+  std::string data_root;
+  std::string format = "auto";
+  std::string split = "test";
+  int max_frames = 0;  // 0 = all
+  int threads = 0;
+  std::function<void(const std::string&)> progress;
+};
+
+inline const std::vector<std::string>& ProposalVariants() {
+  static const std::vector<std::string> v = {"EB", "OLP@1", "OAOCC+OLP@1", "OAOCC+OLP@4",
+                                             "OAOCC+OLP@4+MS"};
+  return v;
+}
+inline const std::vector<std::string>& RegressionVariants() {
+  static const std::vector<std::string> v = {"OP+ORDR@4", "BP+ORDR@4", "BP+Fusion@4"};
+  return v;
+}
+
+struct VariantCurves {
+  std::vector<int> n_grid;             // 0, 5, ..., 1000
+  std::vector<double> recall_at_07;    // recall vs N at IoU 0.7
+  std::vector<double> iou_grid;        // 0.50 ... 1.00
+  std::vector<double> recall_at_1000;  // recall vs IoU at N = 1000
+  std::vector<double> average_recall;  // AR vs N
+  std::map<int, double> ar_table;      // N = 200 ... 1000
+};
+
+struct EvalReport {
+  int frames = 0;
+  int instances = 0;
+  std::map<std::string, VariantCurves> proposals;   // proposal variants
+  std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)
+  std::map<std::string, RocCurve> roc;              // regression variants
+  std::map<std::string, std::map<double, double>> tpr_at_fpr;
+  std::vector<std::pair<std::string, double>> stage_median_ms;  // detector stages + "total"
+};
+
+Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options);
+
+// The JSON of the issue: {"frames","instances","proposals":{V:{"ar":{...}}},
+// "regression":{V:{"tpr_at_fpr":{...},"ar":{...}}},"timing_ms":{STAGE:x,...,"total":x}}.
+nlohmann::json EvalReportToJson(const EvalReport& report);
+// The two tables and the timing table as text.
+std::string FormatEvalTables(const EvalReport& report);
+
+}  // namespace tod

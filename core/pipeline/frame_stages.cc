@@ -1,0 +1,106 @@
+#include "core/pipeline/frame_stages.h"
+
+#include <algorithm>
+#include <optional>
+
+#include "core/features/box_features.h"
+
+namespace tod {
+
+OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerRegions& regions,
+                                     const EdgeSource& edges, const OcclusionClassifier* classifier,
+                                     const StickySuperpixelParams& superpixel_params, bool enhance,
+                                     StageTimer* timer) {
+  auto mark = [timer](const char* stage) {
+    if (timer != nullptr) timer->Mark(stage);
+  };
+  OcclusionEdges out;
+  out.r1 = ClipToImage(regions.layers.front(), image.cols, image.rows);
+  out.crop = image(out.r1.rect());
+  out.base_edge = edges.Compute(out.crop);
+  // §2.2 single pass: Ê(p) = n(p) E(p), n(p) = number of layers containing p. Each inner layer
+  // adds the same map once more over its rectangle.
+  out.enhanced = out.base_edge.clone();
+  if (enhance) {
+    for (int k = 1; k < regions.num_layers(); ++k) {
+      const Box inner = Intersect(regions.layers[k], out.r1);
+      if (inner.empty()) continue;
+      const cv::Rect local(inner.x - out.r1.x, inner.y - out.r1.y, inner.w, inner.h);
+      out.enhanced(local) += out.base_edge(local);
+    }
+  }
+  mark("edges");
+  out.superpixels = ComputeStickySuperpixels(out.crop, out.enhanced, superpixel_params);
+  mark("superpixels");
+  if (classifier != nullptr) {
+    out.occlusion = classifier->Paint(out.crop, out.enhanced, out.superpixels);
+    mark("occlusion");
+  }
+  return out;
+}
+
+cv::Mat1f RegionEdgeMap(const OcclusionEdges& oaocc, const MultilayerRegions& regions, int k) {
+  const Box region = Intersect(regions.layers[k], oaocc.r1);
+  if (region.empty()) return {};
+  const cv::Rect local(region.x - oaocc.r1.x, region.y - oaocc.r1.y, region.w, region.h);
+  cv::Mat1f map = oaocc.occlusion(local).clone();
+  if (k > 0) ClearCropBorderEdges(map);
+  return map;
+}
+
+ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                         const EdgeBoxParams& box_params, const ProposalOptions& options,
+                         const SizeFilter& size_filter) {
+  const int used = std::clamp(options.layers_used, 1, regions.num_layers());
+  const int num_layers = regions.num_layers();
+  std::vector<std::pair<ScoredBox, int>> merged;
+  for (int k = 0; k < used; ++k) {
+    const cv::Mat1f map = RegionEdgeMap(oaocc, regions, k);
+    if (map.empty()) continue;
+    EdgeBoxParams params = box_params;
+    // §4.2.6: stride factor (K - k + 1) / K with paper index k = this k + 1.
+    params.stride_factor = options.multistride
+                               ? static_cast<float>(num_layers - k) / static_cast<float>(num_layers)
+                               : 1.f;
+    const Box region = Intersect(regions.layers[k], oaocc.r1);
+    for (ScoredBox b : ScoreEdgeBoxes(NormaliseToMax(map), params)) {
+      b.box.x += region.x;
+      b.box.y += region.y;
+      if (options.size_filter && size_filter.enabled && !size_filter.Keep(b.box)) continue;
+      merged.emplace_back(b, k);
+    }
+  }
+  // No cross-region NMS (authors' code): the union, ranked by objectness.
+  std::stable_sort(merged.begin(), merged.end(),
+                   [](const auto& a, const auto& b) { return a.first.score > b.first.score; });
+  ProposalSet out;
+  out.boxes.reserve(merged.size());
+  out.layer.reserve(merged.size());
+  for (const auto& [box, k] : merged) {
+    out.boxes.push_back(box);
+    out.layer.push_back(k);
+  }
+  return out;
+}
+
+cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
+                                  const MultilayerRegions& regions, const ProposalSet& proposals) {
+  cv::Mat1f rows(static_cast<int>(proposals.boxes.size()), kNumBoxFeatures, 0.f);
+  if (proposals.boxes.empty()) return rows;
+  // Build each region's extractor once (integral images), only for regions that produced boxes.
+  std::vector<std::optional<BoxFeatureExtractor>> extractors(regions.num_layers());
+  for (std::size_t i = 0; i < proposals.boxes.size(); ++i) {
+    const int k = proposals.layer[i];
+    if (!extractors[k]) {
+      const Box region = Intersect(regions.layers[k], oaocc.r1);
+      extractors[k].emplace(RegionEdgeMap(oaocc, regions, k), image(region.rect()),
+                            cv::Point(region.x, region.y), image.size());
+    }
+    const BoxFeatureVector f = extractors[k]->Compute(proposals.boxes[i].box,
+                                                      proposals.boxes[i].score);
+    std::copy(f.begin(), f.end(), rows.ptr<float>(static_cast<int>(i)));
+  }
+  return rows;
+}
+
+}  // namespace tod

@@ -1,0 +1,58 @@
+// The per-frame stages shared by detection, training and evaluation: obstacle-aware occlusion
+// edges on R1 (§2-3), multistride proposals over the K regions (§4), the 20 features (§5).
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/base/stage_timer.h"
+#include "core/edges/edge_source.h"
+#include "core/edges/occlusion_classifier.h"
+#include "core/edges/sticky_superpixels.h"
+#include "core/pipeline/multilayer_regions.h"
+#include "core/proposals/edge_box_scorer.h"
+#include "core/proposals/size_filter.h"
+
+namespace tod {
+
+struct OcclusionEdges {
+  Box r1;                   // full-image box of the crop
+  cv::Mat3b crop;           // image restricted to R1 (a view into the frame)
+  cv::Mat1f base_edge;      // E
+  cv::Mat1f enhanced;       // Ê = n(p) E(p)
+  Superpixels superpixels;
+  cv::Mat1f occlusion;      // occlusion edge map on the crop
+};
+
+// enhance = false gives the plain (non obstacle-aware) variant used by the OLP baseline.
+// With a null classifier only E, Ê and the superpixels are computed (training of the classifier).
+OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerRegions& regions,
+                                     const EdgeSource& edges, const OcclusionClassifier* classifier,
+                                     const StickySuperpixelParams& superpixel_params, bool enhance,
+                                     StageTimer* timer = nullptr);
+
+// Region k's occlusion edge map (un-normalised): the R1 map cropped to R_k, with the artificial
+// frame edges along the crop border removed for k >= 2 (§3.2(4)). k is 0-based here.
+cv::Mat1f RegionEdgeMap(const OcclusionEdges& oaocc, const MultilayerRegions& regions, int k);
+
+struct ProposalOptions {
+  int layers_used = 4;    // @k: boxes from R_1 .. R_k
+  bool multistride = true;
+  bool size_filter = true;
+};
+
+struct ProposalSet {
+  std::vector<ScoredBox> boxes;  // full-image coordinates, objectness descending
+  std::vector<int> layer;        // 0-based region that produced each box
+};
+
+ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                         const EdgeBoxParams& box_params, const ProposalOptions& options,
+                         const SizeFilter& size_filter);
+
+// One row of 20 features per proposal, each computed on the region that produced it.
+cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
+                                  const MultilayerRegions& regions, const ProposalSet& proposals);
+
+}  // namespace tod

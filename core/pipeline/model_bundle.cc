@@ -1,0 +1,254 @@
+#include "core/pipeline/model_bundle.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace tod {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr const char* kManifest = "manifest.json";
+constexpr const char* kEdgesFile = "edges.bin";
+constexpr const char* kOcclusionFile = "occlusion.bin";
+constexpr const char* kOrdrFile = "ordr.bin";
+constexpr const char* kObdrFile = "obdr.bin";
+
+// 64-bit FNV-1a: enough to detect a truncated or altered file, cheap to compute.
+std::string Fnv1a(const std::string& bytes) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  std::ostringstream s;
+  s << std::hex << h;
+  return s.str();
+}
+
+Status WriteFile(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.flush();
+  if (!out) return Status::Internal("cannot write " + path.string());
+  return Status::Ok();
+}
+
+Result<std::string> ReadFile(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return Status::NotFound(path.string() + ": missing");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound(path.string() + ": cannot open");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+template <typename Model>
+Result<std::string> Serialise(const Model& model) {
+  std::ostringstream out(std::ios::binary);
+  Status st = model.Save(out);
+  if (!st.ok()) return st;
+  return out.str();
+}
+
+}  // namespace
+
+std::string NowIso8601() {
+  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
+                       const std::string& sed_model_source) {
+  const fs::path target = fs::absolute(dir);
+  std::error_code ec;
+  fs::create_directories(target.parent_path(), ec);
+  const std::string suffix = "." + std::to_string(::getpid()) + ".tmp";
+  const fs::path tmp = target.parent_path() / (target.filename().string() + suffix);
+  fs::remove_all(tmp, ec);
+  if (!fs::create_directories(tmp, ec))
+    return Status::Internal("cannot create " + tmp.string() + ": " + ec.message());
+
+  nlohmann::json files = nlohmann::json::object();
+  auto add = [&](const char* name, const Result<std::string>& bytes) -> Status {
+    if (!bytes.ok()) return bytes.status();
+    Status st = WriteFile(tmp / name, *bytes);
+    if (!st.ok()) return st;
+    files[name] = {{"bytes", bytes->size()}, {"fnv1a64", Fnv1a(*bytes)}};
+    return Status::Ok();
+  };
+  Status st;
+  if (bundle.edge_kind == "pixel_forest") {
+    const auto* classifier = dynamic_cast<const PixelEdgeClassifier*>(bundle.edges.get());
+    if (classifier == nullptr) return Status::InvalidArgument("pixel_forest bundle without classifier");
+    st = add(kEdgesFile, Serialise(*classifier));
+    if (!st.ok()) return st;
+  } else if (bundle.edge_kind == "sed") {
+    auto bytes = ReadFile(sed_model_source);
+    st = add("sed_model.yml.gz", bytes);
+    if (!st.ok()) return st;
+  }
+  if ((st = add(kOcclusionFile, Serialise(bundle.occlusion))); !st.ok()) return st;
+  if ((st = add(kOrdrFile, Serialise(bundle.ordr))); !st.ok()) return st;
+  if ((st = add(kObdrFile, Serialise(bundle.obdr))); !st.ok()) return st;
+
+  nlohmann::json manifest;
+  manifest["format_version"] = kBundleFormatVersion;
+  manifest["version"] = bundle.version;
+  manifest["created"] = bundle.created.empty() ? NowIso8601() : bundle.created;
+  manifest["edge_source"] = bundle.edge_kind;
+  if (bundle.edge_kind == "sed") manifest["sed_model_file"] = "sed_model.yml.gz";
+  manifest["params"] = ToJson(bundle.params);
+  manifest["regions"] = bundle.regions.ToJson();
+  manifest["size_filter"] = bundle.size_filter.ToJson();
+  manifest["training"] = bundle.training;
+  manifest["eval"] = bundle.eval;
+  manifest["files"] = files;
+  if ((st = WriteFile(tmp / kManifest, manifest.dump(2) + "\n")); !st.ok()) return st;
+
+  // Swap in: move an existing bundle aside, rename the new one, then delete the old one.
+  const fs::path old = target.parent_path() / (target.filename().string() + "." +
+                                                std::to_string(::getpid()) + ".old");
+  const bool had_old = fs::exists(target, ec);
+  if (had_old) {
+    fs::remove_all(old, ec);
+    fs::rename(target, old, ec);
+    if (ec) return Status::Internal("cannot move old bundle aside: " + ec.message());
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    if (had_old) fs::rename(old, target, ec);
+    return Status::Internal("cannot rename " + tmp.string() + " to " + target.string());
+  }
+  if (had_old) fs::remove_all(old, ec);
+  return Status::Ok();
+}
+
+Result<ModelBundle> LoadModelBundle(const std::string& dir) {
+  const fs::path root(dir);
+  std::error_code ec;
+  if (!fs::is_directory(root, ec))
+    return Status::NotFound(dir + ": model bundle directory does not exist");
+  auto manifest_text = ReadFile(root / kManifest);
+  if (!manifest_text.ok()) return manifest_text.status();
+  const std::string manifest_path = (root / kManifest).string();
+  nlohmann::json manifest;
+  try {
+    manifest = nlohmann::json::parse(*manifest_text);
+  } catch (const nlohmann::json::exception& e) {
+    return Status::DataLoss(manifest_path + ": not valid JSON (" + e.what() + ")");
+  }
+  ModelBundle bundle;
+  try {
+    const int format = manifest.at("format_version").get<int>();
+    if (format != kBundleFormatVersion)
+      return Status::FailedPrecondition(manifest_path + ": format_version " +
+                                        std::to_string(format) + ", this build reads " +
+                                        std::to_string(kBundleFormatVersion));
+    bundle.version = manifest.value("version", "");
+    bundle.created = manifest.value("created", "");
+    bundle.edge_kind = manifest.at("edge_source").get<std::string>();
+    auto params = PipelineParamsFromJson(manifest.at("params"));
+    if (!params.ok()) return Status::InvalidArgument(manifest_path + ": " + params.status().message());
+    bundle.params = *params;
+    auto regions = MultilayerRegions::FromJson(manifest.at("regions"));
+    if (!regions.ok()) return Status::InvalidArgument(manifest_path + ": " + regions.status().message());
+    bundle.regions = *regions;
+    bundle.size_filter = SizeFilter::FromJson(manifest.at("size_filter"));
+    bundle.training = manifest.value("training", nlohmann::json());
+    bundle.eval = manifest.value("eval", nlohmann::json());
+  } catch (const nlohmann::json::exception& e) {
+    return Status::InvalidArgument(manifest_path + ": " + e.what());
+  }
+
+  // Every learned file: present, of the recorded size and checksum, then parsed.
+  auto checked = [&](const std::string& name) -> Result<std::string> {
+    const fs::path path = root / name;
+    auto bytes = ReadFile(path);
+    if (!bytes.ok()) return bytes.status();
+    if (!manifest.contains("files") || !manifest["files"].contains(name))
+      return Status::DataLoss(manifest_path + ": no entry for " + name);
+    const auto& entry = manifest["files"][name];
+    const std::size_t expected = entry.value("bytes", std::size_t{0});
+    if (bytes->size() != expected)
+      return Status::DataLoss(path.string() + ": truncated or altered (" +
+                              std::to_string(bytes->size()) + " bytes, manifest says " +
+                              std::to_string(expected) + ")");
+    if (Fnv1a(*bytes) != entry.value("fnv1a64", ""))
+      return Status::DataLoss(path.string() + ": checksum mismatch (file corrupted)");
+    return bytes;
+  };
+  auto load_forest = [&](const char* name, RandomForest& forest) -> Status {
+    auto bytes = checked(name);
+    if (!bytes.ok()) return bytes.status();
+    std::istringstream in(*bytes, std::ios::binary);
+    auto loaded = RandomForest::Load(in, (root / name).string());
+    if (!loaded.ok()) return loaded.status();
+    forest = std::move(*loaded);
+    return Status::Ok();
+  };
+  Status st = load_forest(kOrdrFile, bundle.ordr);
+  if (!st.ok()) return st;
+  if ((st = load_forest(kObdrFile, bundle.obdr)); !st.ok()) return st;
+  {
+    auto bytes = checked(kOcclusionFile);
+    if (!bytes.ok()) return bytes.status();
+    std::istringstream in(*bytes, std::ios::binary);
+    auto loaded = OcclusionClassifier::Load(in, (root / kOcclusionFile).string());
+    if (!loaded.ok()) return loaded.status();
+    bundle.occlusion = std::move(*loaded);
+  }
+  if (bundle.edge_kind == "pixel_forest") {
+    auto bytes = checked(kEdgesFile);
+    if (!bytes.ok()) return bytes.status();
+    std::istringstream in(*bytes, std::ios::binary);
+    auto loaded = PixelEdgeClassifier::Load(in, (root / kEdgesFile).string());
+    if (!loaded.ok()) return loaded.status();
+    bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*loaded));
+  } else if (bundle.edge_kind == "gradient") {
+    bundle.edges = CreateGradientEdgeSource(bundle.params.gradient_edges);
+  } else if (bundle.edge_kind == "sed") {
+    bundle.sed_model_file = manifest.value("sed_model_file", "sed_model.yml.gz");
+    auto bytes = checked(bundle.sed_model_file);
+    if (!bytes.ok()) return bytes.status();
+    auto sed = CreateSedEdgeSource((root / bundle.sed_model_file).string());
+    if (!sed.ok()) return sed.status();
+    bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
+  } else {
+    return Status::InvalidArgument(manifest_path + ": unknown edge_source '" + bundle.edge_kind + "'");
+  }
+  if (bundle.ordr.num_features() != 20 || bundle.obdr.num_features() != 20)
+    return Status::DataLoss((root / kOrdrFile).string() + ": regressors must take 20 features");
+  return bundle;
+}
+
+Status UpdateManifestEval(const std::string& dir, const nlohmann::json& eval) {
+  const fs::path path = fs::path(dir) / kManifest;
+  auto text = ReadFile(path);
+  if (!text.ok()) return text.status();
+  nlohmann::json manifest;
+  try {
+    manifest = nlohmann::json::parse(*text);
+  } catch (const nlohmann::json::exception& e) {
+    return Status::DataLoss(path.string() + ": not valid JSON");
+  }
+  manifest["eval"] = eval;
+  const fs::path tmp = path.string() + "." + std::to_string(::getpid()) + ".tmp";
+  Status st = WriteFile(tmp, manifest.dump(2) + "\n");
+  if (!st.ok()) return st;
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) return Status::Internal("cannot rename " + tmp.string() + ": " + ec.message());
+  return Status::Ok();
+}
+
+}  // namespace tod

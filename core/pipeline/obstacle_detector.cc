@@ -1,0 +1,116 @@
+#include "core/pipeline/obstacle_detector.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <numeric>
+
+namespace tod {
+
+FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height) {
+  FrameGeometry g;
+  g.regions = bundle.regions.ScaledTo(width, height);
+  g.size_filter = bundle.size_filter;
+  const double sx = static_cast<double>(width) / std::max(1, bundle.regions.image_width);
+  const double sy = static_cast<double>(height) / std::max(1, bundle.regions.image_height);
+  if (sx != 1.0 || sy != 1.0) {
+    for (SizeBand& b : g.size_filter.bands) {
+      b.center_y_min *= sy, b.center_y_max *= sy;
+      b.h_min *= sy, b.h_max *= sy;
+      b.w_min *= sx, b.w_max *= sx;
+      b.area_min *= sx * sy, b.area_max *= sx * sy;
+    }
+  }
+  return g;
+}
+
+RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& image,
+                                    const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                                    ProposalSet proposals, StageTimer* timer) {
+  RegressedProposals out;
+  const cv::Mat1f features = ComputeProposalFeatures(image, oaocc, regions, proposals);
+  if (timer) timer->Mark("features");
+  out.ordr = bundle.ordr.PredictBatch(features);
+  out.obdr = bundle.obdr.PredictBatch(features);
+  if (timer) timer->Mark("regression");
+  out.proposals = std::move(proposals);
+  return out;
+}
+
+ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
+    : bundle_(std::move(bundle)) {
+  info_.name = std::move(name);
+  info_.version = bundle_.version;
+  info_.format_version = kBundleFormatVersion;
+  info_.created = bundle_.created;
+  info_.trained_on = bundle_.training.value("data", std::string());
+  info_.edge_source = bundle_.edge_kind;
+  info_.manifest = {{"version", bundle_.version},
+                    {"created", bundle_.created},
+                    {"edge_source", bundle_.edge_kind},
+                    {"params", ToJson(bundle_.params)},
+                    {"regions", bundle_.regions.ToJson()},
+                    {"size_filter", bundle_.size_filter.ToJson()},
+                    {"training", bundle_.training},
+                    {"eval", bundle_.eval}};
+}
+
+Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOptions& options) const {
+  if (bgr.empty()) return Status::InvalidArgument("empty image");
+  if (bgr.cols < 16 || bgr.rows < 16)
+    return Status::InvalidArgument("image too small: " + std::to_string(bgr.cols) + "x" +
+                                   std::to_string(bgr.rows) + " (at least 16x16)");
+  StageTimer timer;
+  const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
+  const OcclusionEdges oaocc = ComputeOcclusionEdges(
+      bgr, geometry.regions, *bundle_.edges, &bundle_.occlusion, bundle_.params.superpixels,
+      /*enhance=*/true, &timer);
+  ProposalOptions proposal_options;
+  proposal_options.layers_used = geometry.regions.num_layers();
+  proposal_options.multistride = bundle_.params.multistride;
+  proposal_options.size_filter = bundle_.params.size_filter;
+  ProposalSet proposals = ProposeBoxes(oaocc, geometry.regions, bundle_.params.boxes,
+                                       proposal_options, geometry.size_filter);
+  timer.Mark("proposals");
+  RegressedProposals regressed =
+      RegressProposals(bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer);
+  const std::vector<float> fused = FuseScores(regressed.ordr, regressed.obdr, bundle_.params.fusion);
+
+  std::vector<ScoredBox> scored(fused.size());
+  for (std::size_t i = 0; i < fused.size(); ++i)
+    scored[i] = {regressed.proposals.boxes[i].box, fused[i]};
+  const cv::Mat1f probability =
+      AccumulateProbabilityMap(scored, bgr.size(), bundle_.params.probability_map);
+  Detection out;
+  out.width = bgr.cols;
+  out.height = bgr.rows;
+  for (const ObstacleComponent& c : ThresholdObstacles(probability, options.obstacle_threshold))
+    out.obstacles.push_back({c.box, c.area, c.peak, c.mean});
+  timer.Mark("probability_map");
+
+  std::vector<std::size_t> order(fused.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    if (fused[a] != fused[b]) return fused[a] > fused[b];
+    return regressed.ordr[a] > regressed.ordr[b];
+  });
+  const std::size_t n = std::min<std::size_t>(order.size(), std::max(0, options.max_proposals));
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = order[r];
+    out.proposals.push_back(
+        {regressed.proposals.boxes[i].box, fused[i], regressed.ordr[i], regressed.obdr[i]});
+  }
+  if (options.want_probability_map) out.probability = probability;
+  out.timings = timer.times();
+  return out;
+}
+
+Result<std::shared_ptr<const Detector>> Detector::Load(const std::string& model_dir) {
+  auto bundle = LoadModelBundle(model_dir);
+  if (!bundle.ok()) return bundle.status();
+  const std::string name =
+      std::filesystem::path(model_dir).lexically_normal().filename().string();
+  return std::shared_ptr<const Detector>(
+      std::make_shared<ObstacleDetector>(std::move(*bundle), name.empty() ? "model" : name));
+}
+
+}  // namespace tod

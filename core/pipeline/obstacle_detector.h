@@ -1,0 +1,42 @@
+// The Detector implementation: a loaded model bundle run stage by stage on one frame.
+#pragma once
+
+#include <memory>
+
+#include "core/pipeline/detector.h"
+#include "core/pipeline/frame_stages.h"
+#include "core/pipeline/model_bundle.h"
+
+namespace tod {
+
+// Regions and size filter of a bundle for frames of a given size (scaled proportionally when the
+// frame size differs from the training size).
+struct FrameGeometry {
+  MultilayerRegions regions;
+  SizeFilter size_filter;
+};
+FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height);
+
+// ORDR and OBDR scores of every proposal (features computed here).
+struct RegressedProposals {
+  ProposalSet proposals;
+  std::vector<float> ordr;
+  std::vector<float> obdr;
+};
+RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& image,
+                                    const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                                    ProposalSet proposals, StageTimer* timer = nullptr);
+
+class ObstacleDetector final : public Detector {
+ public:
+  ObstacleDetector(ModelBundle bundle, std::string name);
+  Result<Detection> Detect(const cv::Mat3b& bgr, const DetectOptions& options) const override;
+  const ModelInfo& info() const override { return info_; }
+  const ModelBundle& bundle() const { return bundle_; }
+
+ private:
+  ModelBundle bundle_;
+  ModelInfo info_;
+};
+
+}  // namespace tod

@@ -1,0 +1,32 @@
+// Every parameter of the pipeline in one struct, with the paper's defaults (ALGORITHM.md). The
+// bundle's manifest stores it, so a model always runs with what it was trained with.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "core/base/status.h"
+#include "core/edges/edge_source.h"
+#include "core/edges/occlusion_classifier.h"
+#include "core/edges/sticky_superpixels.h"
+#include "core/pipeline/multilayer_regions.h"
+#include "core/pipeline/probability_map.h"
+#include "core/proposals/edge_box_scorer.h"
+
+namespace tod {
+
+struct PipelineParams {
+  RegionParams regions;
+  GradientEdgeParams gradient_edges;
+  StickySuperpixelParams superpixels;
+  EdgeBoxParams boxes;
+  bool multistride = true;     // MS: stride factor (K - k + 1) / K in region k (§4.2.6)
+  bool size_filter = true;     // §4.3, switchable
+  FusionParams fusion;
+  ProbabilityMapParams probability_map;
+};
+
+nlohmann::json ToJson(const PipelineParams& params);
+// Missing keys keep their defaults; wrong types are an error naming the key.
+Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j);
+
+}  // namespace tod

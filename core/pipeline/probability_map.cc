@@ -1,0 +1,100 @@
+#include "core/pipeline/probability_map.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/proposals/edge_box_scorer.h"
+
+namespace tod {
+
+std::vector<float> FuseScores(const std::vector<float>& ordr, const std::vector<float>& obdr,
+                              const FusionParams& params) {
+  const std::size_t n = ordr.size();
+  std::vector<float> fused(n, 0.f);
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return ordr[a] > ordr[b]; });
+  const std::size_t keep = static_cast<std::size_t>(params.keep_ratio * static_cast<float>(n));
+  for (std::size_t r = 0; r < keep; ++r) {
+    const std::size_t i = order[r];
+    fused[i] = ordr[i] + params.beta1 * (i < obdr.size() ? obdr[i] : 0.f);
+  }
+  return fused;
+}
+
+std::vector<ScoredBox> RankedAboveThreshold(const std::vector<ScoredBox>& boxes, float min_score) {
+  std::vector<ScoredBox> kept;
+  for (const auto& b : boxes)
+    if (b.score > min_score) kept.push_back(b);
+  std::stable_sort(kept.begin(), kept.end(),
+                   [](const ScoredBox& a, const ScoredBox& b) { return a.score > b.score; });
+  return kept;
+}
+
+cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
+                                   const ProbabilityMapParams& params) {
+  const std::vector<ScoredBox> ranked = RankedAboveThreshold(boxes, params.min_score);
+  const std::vector<ScoredBox> kept =
+      NonMaximumSuppression(ranked, params.nms_iou, params.max_boxes);
+  const std::size_t top = static_cast<std::size_t>(params.top_fraction * kept.size());
+  // 2-D difference image: +s at the box's top-left, -s past its right / bottom, prefix sums.
+  cv::Mat1d diff = cv::Mat1d::zeros(image_size.height + 1, image_size.width + 1);
+  for (std::size_t i = 0; i < top; ++i) {
+    const Box b = ClipToImage(kept[i].box, image_size.width, image_size.height);
+    if (b.empty()) continue;
+    const double s = kept[i].score;
+    diff(b.y, b.x) += s;
+    diff(b.y, b.right()) -= s;
+    diff(b.bottom(), b.x) -= s;
+    diff(b.bottom(), b.right()) += s;
+  }
+  cv::Mat1f prob(image_size, 0.f);
+  std::vector<double> column(image_size.width + 1, 0.0);
+  double peak = 0;
+  for (int y = 0; y < image_size.height; ++y) {
+    double run = 0;
+    for (int x = 0; x < image_size.width; ++x) {
+      column[x] += diff(y, x);
+      run += column[x];
+      prob(y, x) = static_cast<float>(run);
+      peak = std::max(peak, run);
+    }
+  }
+  if (peak > 0) prob *= 1.0 / peak;
+  cv::max(prob, 0.f, prob);  // rounding in the prefix sums must not leave tiny negatives
+  return prob;
+}
+
+std::vector<ObstacleComponent> ThresholdObstacles(const cv::Mat1f& probability, float threshold) {
+  std::vector<ObstacleComponent> out;
+  if (probability.empty()) return out;
+  const cv::Mat1b mask = probability > threshold;
+  cv::Mat1i labels;
+  cv::Mat stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  out.resize(std::max(0, n - 1));
+  std::vector<double> sums(out.size(), 0.0);
+  for (int y = 0; y < labels.rows; ++y)
+    for (int x = 0; x < labels.cols; ++x) {
+      const int l = labels(y, x);
+      if (l == 0) continue;
+      const float p = probability(y, x);
+      out[l - 1].peak = std::max(out[l - 1].peak, p);
+      sums[l - 1] += p;
+    }
+  for (int l = 1; l < n; ++l) {
+    auto& c = out[l - 1];
+    c.box = {stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+             stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT)};
+    c.area = stats.at<int>(l, cv::CC_STAT_AREA);
+    c.mean = c.area > 0 ? static_cast<float>(sums[l - 1] / c.area) : 0.f;
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const ObstacleComponent& a, const ObstacleComponent& b) { return a.peak > b.peak; });
+  return out;
+}
+
+}  // namespace tod

@@ -1,0 +1,48 @@
+// Fusion of the two regressors and the obstacle-occupied probability map (ALGORITHM.md §6.5, §7).
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/base/types.h"
+
+namespace tod {
+
+struct FusionParams {
+  float beta1 = 0.3f;     // weight of OBDR
+  float keep_ratio = 0.5f;  // tau_beta: the top half by ORDR passes the gate
+};
+
+// F(b) = ORDR(b) + beta1 * OBDR(b) for the top floor(keep_ratio * n) boxes by ORDR (stable
+// order on ties), 0 for the rest.
+std::vector<float> FuseScores(const std::vector<float>& ordr, const std::vector<float>& obdr,
+                              const FusionParams& params = {});
+
+struct ProbabilityMapParams {
+  float min_score = 0.25f;   // boxes at or below are dropped (authors' code)
+  float nms_iou = 0.7f;
+  int max_boxes = 1000;
+  float top_fraction = 0.5f;  // the top half of the kept boxes is accumulated
+};
+
+// Score-sorted boxes with score > min_score (before NMS): the ranked list used for instance
+// recall of the regressed variants.
+std::vector<ScoredBox> RankedAboveThreshold(const std::vector<ScoredBox>& boxes, float min_score);
+
+// §7 steps 2-5: threshold, NMS, top fraction, accumulate per pixel (difference image + prefix
+// sums, so the cost is linear in boxes plus pixels), normalise by the maximum.
+cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
+                                   const ProbabilityMapParams& params = {});
+
+struct ObstacleComponent {
+  Box box;
+  long long area = 0;
+  float peak = 0.f;
+  float mean = 0.f;
+};
+
+// Connected components (8-connected) of P > threshold, largest peak first.
+std::vector<ObstacleComponent> ThresholdObstacles(const cv::Mat1f& probability, float threshold);
+
+}  // namespace tod

@@ -1,0 +1,42 @@
+// `tod train`: learns every part of the model from a dataset's training split - multilayer
+// regions, size filter, pixel edge classifier, occlusion classifier, ORDR and OBDR - and returns
+// the bundle (the caller saves it).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "core/edges/edge_source.h"
+#include "core/edges/occlusion_classifier.h"
+#include "core/features/sample_selection.h"
+#include "core/forest/random_forest.h"
+#include "core/pipeline/model_bundle.h"
+
+namespace tod {
+
+struct TrainOptions {
+  std::string data_root;
+  std::string format = "auto";          // auto | laf | modd2
+  std::string split = "train";
+  std::string regions = "auto";         // auto (k-means on the training obstacles) | laf2020
+  std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
+  std::string sed_model;                // model file for edge_source "sed"
+  std::uint64_t seed = 1;
+  int max_frames = 0;                   // 0 = the whole split
+  int classifier_frames = 60;           // frames used for the edge and occlusion classifiers
+  int threads = 0;                      // 0 = all cores
+  PipelineParams params;
+  PixelEdgeParams edge_params;
+  OcclusionParams occlusion_params;
+  ForestParams regressor{.num_trees = 200, .max_features = 6, .min_leaf_size = 5};
+  SampleSelectionParams selection;
+  std::function<void(const std::string&)> progress;  // one line per step
+};
+
+Result<ModelBundle> TrainModel(const TrainOptions& options);
+
+// Per-pixel labels for classifier training: 1 road, 2 + i obstacle instance i, 0 everything else.
+cv::Mat1i LabelMap(const Sample& sample);
+
+}  // namespace tod

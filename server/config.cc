@@ -1,0 +1,193 @@
+#include "server/config.h"
+
+#include <algorithm>
+#include <charconv>
+#include <fstream>
+#include <thread>
+
+namespace tod::server {
+namespace {
+
+template <typename T>
+Status ParseNumber(const std::string& text, const std::string& what, T* out) {
+  const char* begin = text.data();
+  const char* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(begin, end, *out);
+  if (ec != std::errc() || ptr != end || text.empty()) {
+    return Status::InvalidArgument(what + ": '" + text + "' is not a valid number");
+  }
+  return Status::Ok();
+}
+
+std::string JsonValueAsText(const nlohmann::json& value) {
+  return value.is_string() ? value.get<std::string>() : value.dump();
+}
+
+}  // namespace
+
+const std::vector<SettingSpec>& SettingSpecs() {
+  static const std::vector<SettingSpec> specs = {
+      {"model", "model", "TOD_MODEL", "Model bundle directory (required)"},
+      {"host", "host", "TOD_HOST", "Bind address for both listeners (default 0.0.0.0)"},
+      {"grpc_port", "grpc-port", "TOD_GRPC_PORT", "gRPC port (default 8001)"},
+      {"http_port", "http-port", "TOD_HTTP_PORT", "REST port (default 8000)"},
+      {"workers", "workers", "TOD_WORKERS", "Worker threads (default: number of cores)"},
+      {"queue", "queue", "TOD_QUEUE", "Requests allowed to wait for a worker (default 64)"},
+      {"max_image_bytes", "max-image-bytes", "TOD_MAX_IMAGE_BYTES",
+       "Largest encoded image accepted, bytes (default 16 MiB)"},
+      {"max_image_pixels", "max-image-pixels", "TOD_MAX_IMAGE_PIXELS",
+       "Largest image accepted, width*height (default 16e6, at most 1e8)"},
+      {"drain_timeout_s", "drain-timeout", "TOD_DRAIN_TIMEOUT",
+       "Seconds SIGTERM waits for queued and running work (default 20)"},
+      {"retry_after_s", "retry-after", "TOD_RETRY_AFTER",
+       "Retry-After seconds sent with 503 queue-full (default 1)"},
+      {"http_threads", "http-threads", "TOD_HTTP_THREADS", "REST connection threads (default 16)"},
+      {"log_format", "log-format", "TOD_LOG_FORMAT", "text | json (default text)"},
+      {"log_level", "log-level", "TOD_LOG_LEVEL", "trace|debug|info|warn|error (default info)"},
+  };
+  return specs;
+}
+
+Status ApplySetting(const std::string& key, const std::string& value, const std::string& source,
+                    ServerConfig* config) {
+  const std::string what = source + " " + key;
+  if (key == "model") {
+    config->model_dir = value;
+  } else if (key == "host") {
+    config->host = value;
+  } else if (key == "grpc_port") {
+    return ParseNumber(value, what, &config->grpc_port);
+  } else if (key == "http_port") {
+    return ParseNumber(value, what, &config->http_port);
+  } else if (key == "workers") {
+    return ParseNumber(value, what, &config->workers);
+  } else if (key == "queue") {
+    return ParseNumber(value, what, &config->queue);
+  } else if (key == "max_image_bytes") {
+    return ParseNumber(value, what, &config->max_image_bytes);
+  } else if (key == "max_image_pixels") {
+    return ParseNumber(value, what, &config->max_image_pixels);
+  } else if (key == "drain_timeout_s") {
+    return ParseNumber(value, what, &config->drain_timeout_s);
+  } else if (key == "retry_after_s") {
+    return ParseNumber(value, what, &config->retry_after_s);
+  } else if (key == "http_threads") {
+    return ParseNumber(value, what, &config->http_threads);
+  } else if (key == "log_format") {
+    config->log_format = value;
+  } else if (key == "log_level") {
+    config->log_level = value;
+  } else {
+    return Status::InvalidArgument(source + ": unknown setting '" + key + "'");
+  }
+  return Status::Ok();
+}
+
+Status ApplyJsonSettings(const nlohmann::json& settings, const std::string& source,
+                         ServerConfig* config) {
+  if (!settings.is_object()) {
+    return Status::InvalidArgument(source + ": expected a JSON object of settings");
+  }
+  for (const auto& [key, value] : settings.items()) {
+    if (value.is_object() || value.is_array() || value.is_null()) {
+      return Status::InvalidArgument(source + ": setting '" + key + "' must be a scalar");
+    }
+    if (Status s = ApplySetting(key, JsonValueAsText(value), source, config); !s.ok()) return s;
+  }
+  return Status::Ok();
+}
+
+Result<ServerConfig> ResolveServerConfig(const std::map<std::string, std::string>& flags,
+                                         const EnvLookup& env) {
+  ServerConfig config;
+  std::string config_file;
+  if (auto it = flags.find("config"); it != flags.end()) {
+    config_file = it->second;
+  } else if (const char* from_env = env("TOD_CONFIG"); from_env != nullptr && *from_env) {
+    config_file = from_env;
+  }
+  if (!config_file.empty()) {
+    std::ifstream in(config_file);
+    if (!in) return Status::NotFound("config file " + config_file + ": cannot open");
+    nlohmann::json settings;
+    try {
+      in >> settings;
+    } catch (const nlohmann::json::exception& e) {
+      return Status::InvalidArgument("config file " + config_file + ": invalid JSON: " + e.what());
+    }
+    if (Status s = ApplyJsonSettings(settings, "config file " + config_file, &config); !s.ok()) {
+      return s;
+    }
+  }
+  for (const SettingSpec& spec : SettingSpecs()) {
+    if (const char* value = env(spec.env.c_str()); value != nullptr && *value) {
+      if (Status s = ApplySetting(spec.key, value, "environment " + spec.env, &config); !s.ok()) {
+        return s;
+      }
+    }
+  }
+  for (const auto& [key, value] : flags) {
+    if (key == "config") continue;
+    if (Status s = ApplySetting(key, value, "flag", &config); !s.ok()) return s;
+  }
+  if (config.workers == 0) {
+    config.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  }
+  if (Status s = ValidateServerConfig(config); !s.ok()) return s;
+  return config;
+}
+
+Status ValidateServerConfig(const ServerConfig& config) {
+  if (config.model_dir.empty()) {
+    return Status::InvalidArgument("model: no model bundle given (--model DIR or TOD_MODEL)");
+  }
+  auto port_ok = [](int port) { return port >= 0 && port <= 65535; };
+  if (!port_ok(config.grpc_port)) return Status::InvalidArgument("grpc_port: not in 0..65535");
+  if (!port_ok(config.http_port)) return Status::InvalidArgument("http_port: not in 0..65535");
+  if (config.grpc_port != 0 && config.grpc_port == config.http_port) {
+    return Status::InvalidArgument("grpc_port and http_port must differ");
+  }
+  if (config.workers < 1 || config.workers > 1024) {
+    return Status::InvalidArgument("workers: must be in 1..1024");
+  }
+  if (config.queue < 0) return Status::InvalidArgument("queue: must be >= 0");
+  if (config.max_image_bytes < 64 || config.max_image_bytes > (1u << 30)) {
+    return Status::InvalidArgument("max_image_bytes: must be in 64..1073741824");
+  }
+  if (config.max_image_pixels < 1 || config.max_image_pixels > kAbsoluteMaxPixels) {
+    return Status::InvalidArgument("max_image_pixels: must be in 1.." +
+                                   std::to_string(kAbsoluteMaxPixels));
+  }
+  if (!(config.drain_timeout_s >= 0)) return Status::InvalidArgument("drain_timeout_s: < 0");
+  if (config.retry_after_s < 0) return Status::InvalidArgument("retry_after_s: must be >= 0");
+  if (config.http_threads < 1 || config.http_threads > 1024) {
+    return Status::InvalidArgument("http_threads: must be in 1..1024");
+  }
+  if (config.log_format != "text" && config.log_format != "json") {
+    return Status::InvalidArgument("log_format: '" + config.log_format + "' is not text or json");
+  }
+  static const std::vector<std::string> levels = {"trace", "debug", "info", "warn", "error"};
+  if (std::find(levels.begin(), levels.end(), config.log_level) == levels.end()) {
+    return Status::InvalidArgument("log_level: '" + config.log_level + "' is not one of " +
+                                   "trace, debug, info, warn, error");
+  }
+  return Status::Ok();
+}
+
+nlohmann::json ServerConfigToJson(const ServerConfig& config) {
+  return {{"model", config.model_dir},
+          {"host", config.host},
+          {"grpc_port", config.grpc_port},
+          {"http_port", config.http_port},
+          {"workers", config.workers},
+          {"queue", config.queue},
+          {"max_image_bytes", config.max_image_bytes},
+          {"max_image_pixels", config.max_image_pixels},
+          {"drain_timeout_s", config.drain_timeout_s},
+          {"retry_after_s", config.retry_after_s},
+          {"http_threads", config.http_threads},
+          {"log_format", config.log_format},
+          {"log_level", config.log_level}};
+}
+
+}  // namespace tod::server

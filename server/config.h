@@ -1,0 +1,61 @@
+// Server configuration from three sources, lowest to highest precedence: an optional JSON file
+// (--config / TOD_CONFIG), TOD_* environment variables, command-line flags.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/base/status.h"
+
+namespace tod::server {
+
+struct ServerConfig {
+  std::string model_dir;         // required
+  std::string host = "0.0.0.0";  // bind address of both listeners
+  int grpc_port = 8001;
+  int http_port = 8000;
+  int workers = 0;                     // 0: one per core
+  int queue = 64;                      // requests waiting for a worker
+  size_t max_image_bytes = 16u << 20;  // encoded request body
+  long long max_image_pixels = 16'000'000;
+  double drain_timeout_s = 20;      // SIGTERM: time allowed for queued + running work
+  int retry_after_s = 1;            // Retry-After on 503 (queue full)
+  int http_threads = 16;            // REST connection threads
+  std::string log_format = "text";  // text | json
+  std::string log_level = "info";   // trace | debug | info | warn | error
+};
+
+// Absolute pixel ceiling no configuration may exceed (decompression-bomb guard).
+inline constexpr long long kAbsoluteMaxPixels = 100'000'000;
+
+// The settings: JSON key, flag (without "--"), environment variable, help.
+struct SettingSpec {
+  std::string key;
+  std::string flag;
+  std::string env;
+  std::string help;
+};
+const std::vector<SettingSpec>& SettingSpecs();
+
+// Sets one setting from text; `source` names where it came from, for the error message.
+Status ApplySetting(const std::string& key, const std::string& value, const std::string& source,
+                    ServerConfig* config);
+// Applies a JSON object of settings (keys as in SettingSpecs). Unknown keys are errors.
+Status ApplyJsonSettings(const nlohmann::json& settings, const std::string& source,
+                         ServerConfig* config);
+
+using EnvLookup = std::function<const char*(const char*)>;
+
+// Defaults < file < environment < flags. `flags` maps SettingSpec::key (or "config") to the
+// flag's text. Checks the result (required model, port ranges, positive sizes).
+Result<ServerConfig> ResolveServerConfig(const std::map<std::string, std::string>& flags,
+                                         const EnvLookup& env);
+
+Status ValidateServerConfig(const ServerConfig& config);
+nlohmann::json ServerConfigToJson(const ServerConfig& config);
+
+}  // namespace tod::server

@@ -1,0 +1,278 @@
+#include "server/core/inference_engine.h"
+
+#include <exception>
+#include <opencv2/core/utility.hpp>
+#include <utility>
+
+#include "server/core/image_header.h"
+#include "server/metrics.h"
+
+namespace tod::server {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+InferenceResult Refusal(Status status, Rejection rejection) {
+  InferenceResult result;
+  result.status = std::move(status);
+  result.rejection = rejection;
+  return result;
+}
+
+}  // namespace
+
+const char* RejectionName(Rejection rejection) {
+  switch (rejection) {
+    case Rejection::kNone:
+      return "none";
+    case Rejection::kNotReady:
+      return "not_ready";
+    case Rejection::kQueueFull:
+      return "queue_full";
+    case Rejection::kTooLarge:
+      return "too_large";
+    case Rejection::kBadImage:
+      return "bad_image";
+    case Rejection::kBadRequest:
+      return "bad_request";
+    case Rejection::kDeadline:
+      return "deadline";
+    case Rejection::kInternal:
+      return "internal";
+  }
+  return "unknown";
+}
+
+InferenceEngine::InferenceEngine(EngineConfig config, const ModelHolder& models,
+                                 ServerMetrics* metrics)
+    : config_(std::move(config)), models_(models), metrics_(metrics) {}
+
+InferenceEngine::~InferenceEngine() { Stop(); }
+
+void InferenceEngine::Start() {
+  std::lock_guard lock(mutex_);
+  if (!workers_.empty() || stopping_) return;
+  for (int i = 0; i < config_.workers; ++i) workers_.emplace_back([this] { WorkerLoop(); });
+}
+
+Status InferenceEngine::ValidateOptions(const DetectOptions& options) const {
+  if (options.max_proposals < 0 || options.max_proposals > config_.max_proposals_cap) {
+    return Status::InvalidArgument("max_proposals: " + std::to_string(options.max_proposals) +
+                                   " is outside [0, " + std::to_string(config_.max_proposals_cap) +
+                                   "]");
+  }
+  if (!(options.obstacle_threshold >= 0.f && options.obstacle_threshold <= 1.f)) {
+    return Status::InvalidArgument(
+        "obstacle_threshold: " + std::to_string(options.obstacle_threshold) + " is outside [0, 1]");
+  }
+  return Status::Ok();
+}
+
+void InferenceEngine::Finish(Completion& done, InferenceResult result,
+                             Clock::time_point submitted) const {
+  result.total_ms = MillisecondsSince(submitted);
+  if (metrics_ != nullptr && result.rejection != Rejection::kNone) {
+    metrics_->RecordRejection(RejectionName(result.rejection));
+  }
+  done(std::move(result));
+}
+
+void InferenceEngine::Submit(const InferenceRequest& request, Completion done) {
+  const Clock::time_point submitted = Clock::now();
+  // Cheap checks first, so a request that can never succeed does not take a queue slot.
+  if (!Ready()) {
+    Finish(done,
+           Refusal(Status::Unavailable(draining() ? "server is shutting down; retry elsewhere"
+                                                  : "model not loaded yet; retry shortly"),
+                   Rejection::kNotReady),
+           submitted);
+    return;
+  }
+  if (Status valid = ValidateOptions(request.options); !valid.ok()) {
+    Finish(done, Refusal(std::move(valid), Rejection::kBadRequest), submitted);
+    return;
+  }
+  if (request.image.size() > config_.limits.max_bytes) {
+    Finish(done,
+           Refusal(Status::ResourceExhausted("image: " + std::to_string(request.image.size()) +
+                                             " bytes is over the limit of " +
+                                             std::to_string(config_.limits.max_bytes) + " bytes"),
+                   Rejection::kTooLarge),
+           submitted);
+    return;
+  }
+  if (Result<ImageHeader> header = PeekImageHeader(request.image); !header.ok()) {
+    Finish(done, Refusal(header.status(), Rejection::kBadImage), submitted);
+    return;
+  } else if (static_cast<long long>(header->size.width) * header->size.height >
+             config_.limits.max_pixels) {
+    Finish(done,
+           Refusal(Status::ResourceExhausted("image: " + std::to_string(header->size.width) + "x" +
+                                             std::to_string(header->size.height) +
+                                             " pixels is over the limit of " +
+                                             std::to_string(config_.limits.max_pixels) + " pixels"),
+                   Rejection::kTooLarge),
+           submitted);
+    return;
+  }
+  {
+    std::unique_lock lock(mutex_);
+    if (static_cast<int>(queue_.size()) >= config_.queue_capacity) {
+      const size_t depth = queue_.size();
+      lock.unlock();
+      Finish(done,
+             Refusal(Status::ResourceExhausted("server busy: the queue is full (" +
+                                               std::to_string(depth) +
+                                               " waiting); retry after a short pause"),
+                     Rejection::kQueueFull),
+             submitted);
+      return;
+    }
+    queue_.push_back(Job{request, std::move(done), submitted});
+    if (metrics_ != nullptr) {
+      metrics_->SetQueueDepth(static_cast<double>(queue_.size()));
+      metrics_->AddInFlight(1);
+    }
+  }
+  work_available_.notify_one();
+}
+
+void InferenceEngine::WorkerLoop() {
+  // Parallelism comes from the worker pool; OpenCV's own thread pool inside each worker would
+  // only oversubscribe the cores.
+  cv::setNumThreads(1);
+  for (;;) {
+    Job job;
+    bool stop_now = false;
+    {
+      std::unique_lock lock(mutex_);
+      work_available_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping and nothing left
+      job = std::move(queue_.front());
+      queue_.pop_front();
+      ++running_;
+      stop_now = stopping_;
+      if (metrics_ != nullptr) metrics_->SetQueueDepth(static_cast<double>(queue_.size()));
+    }
+    InferenceResult result;
+    if (stop_now) {  // Stop() came before this job could start
+      result = Refusal(Status::Unavailable("server shut down before the request ran"),
+                       Rejection::kNotReady);
+    } else {
+      result = Run(job);
+    }
+    Finish(job.done, std::move(result), job.submitted);
+    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
+    {
+      std::lock_guard lock(mutex_);
+      --running_;
+    }
+    idle_.notify_all();
+  }
+}
+
+InferenceResult InferenceEngine::Run(const Job& job) const {
+  const double queue_ms = MillisecondsSince(job.submitted);
+  if (metrics_ != nullptr) metrics_->ObserveQueueWait(queue_ms / 1000.0);
+  const InferenceRequest& request = job.request;
+  if (request.deadline && Clock::now() >= *request.deadline) {
+    return Refusal(Status::DeadlineExceeded("deadline passed after " +
+                                            std::to_string(static_cast<int>(queue_ms)) +
+                                            " ms in the queue; the request was not run"),
+                   Rejection::kDeadline);
+  }
+  InferenceResult result;
+  result.timings.emplace_back("queue", queue_ms);
+  result.model = models_.Current();  // this request's model, whatever reloads happen meanwhile
+  if (!result.model) {
+    return Refusal(Status::Unavailable("no model loaded"), Rejection::kNotReady);
+  }
+
+  StageTimer timer;
+  Result<cv::Mat3b> image = DecodeImage(request.image, config_.limits);
+  if (!image.ok()) {
+    const Rejection why = image.status().code() == StatusCode::kResourceExhausted
+                              ? Rejection::kTooLarge
+                              : Rejection::kBadImage;
+    return Refusal(image.status(), why);
+  }
+  timer.Mark("decode");
+  result.timings.insert(result.timings.end(), timer.times().begin(), timer.times().end());
+
+  DetectOptions options = request.options;
+  options.want_probability_map = request.encode_map_png;
+  try {
+    Result<Detection> detection = result.model->detector->Detect(*image, options);
+    if (!detection.ok()) {
+      const Rejection why = detection.status().code() == StatusCode::kInvalidArgument
+                                ? Rejection::kBadImage
+                                : Rejection::kInternal;
+      return Refusal(detection.status(), why);
+    }
+    result.detection = std::move(*detection);
+  } catch (const std::exception& e) {
+    return Refusal(Status::Internal(std::string("pipeline failed: ") + e.what()),
+                   Rejection::kInternal);
+  }
+  result.timings.insert(result.timings.end(), result.detection.timings.begin(),
+                        result.detection.timings.end());
+
+  if (request.encode_map_png && !result.detection.probability.empty()) {
+    const Clock::time_point encode_start = Clock::now();
+    Result<std::string> png = EncodeProbabilityPng(result.detection.probability);
+    if (!png.ok()) return Refusal(png.status(), Rejection::kInternal);
+    result.map_png = std::move(*png);
+    result.timings.emplace_back("encode_map", MillisecondsSince(encode_start));
+  }
+  if (metrics_ != nullptr) metrics_->ObserveStages(result.timings);
+  return result;
+}
+
+bool InferenceEngine::Ready() const {
+  std::lock_guard lock(mutex_);
+  return !draining_ && !stopping_ && models_.Current() != nullptr;
+}
+
+void InferenceEngine::BeginDrain() {
+  std::lock_guard lock(mutex_);
+  draining_ = true;
+}
+
+bool InferenceEngine::draining() const {
+  std::lock_guard lock(mutex_);
+  return draining_ || stopping_;
+}
+
+bool InferenceEngine::WaitIdle(Clock::time_point deadline) {
+  std::unique_lock lock(mutex_);
+  return idle_.wait_until(lock, deadline, [this] { return queue_.empty() && running_ == 0; });
+}
+
+void InferenceEngine::Stop() {
+  std::vector<std::thread> workers;
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    workers.swap(workers_);
+  }
+  work_available_.notify_all();
+  for (std::thread& worker : workers) worker.join();
+  // With no workers left (never started, or all joined), answer whatever is still queued.
+  std::deque<Job> leftover;
+  {
+    std::lock_guard lock(mutex_);
+    leftover.swap(queue_);
+  }
+  for (Job& job : leftover) {
+    Finish(job.done,
+           Refusal(Status::Unavailable("server shut down before the request ran"),
+                   Rejection::kNotReady),
+           job.submitted);
+    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
+  }
+}
+
+}  // namespace tod::server

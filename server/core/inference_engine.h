@@ -1,0 +1,126 @@
+// Admission control and the worker pool, shared by the gRPC and REST frontends (Triton-style:
+// frontends only translate; everything about queueing, deadlines and draining lives here).
+//
+// A request is checked (readiness, byte size, image header and pixel count) when submitted and
+// refused at once if it cannot be served; otherwise it waits in one bounded FIFO queue for one of
+// N workers. A worker skips a request whose deadline passed while it was queued, decodes the image,
+// takes a snapshot of the current model and runs the pipeline.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "core/base/stage_timer.h"
+#include "core/base/status.h"
+#include "core/pipeline/detector.h"
+#include "server/core/image_codec.h"
+#include "server/core/model_holder.h"
+
+namespace tod::server {
+
+class ServerMetrics;
+
+// Why a request did not produce a detection; the frontends map it onto protocol codes.
+enum class Rejection {
+  kNone,
+  kNotReady,    // no model yet, or draining          -> UNAVAILABLE / 503
+  kQueueFull,   //                                    -> RESOURCE_EXHAUSTED / 503 + Retry-After
+  kTooLarge,    // byte or pixel limit                -> RESOURCE_EXHAUSTED / 413
+  kBadImage,    // empty / undecodable                -> INVALID_ARGUMENT / 400
+  kBadRequest,  // invalid option                     -> INVALID_ARGUMENT / 400
+  kDeadline,    // deadline passed while queued       -> DEADLINE_EXCEEDED / 504
+  kInternal,    // pipeline failure                   -> INTERNAL / 500
+};
+// Stable lower-case name, used as the metrics label "reason".
+const char* RejectionName(Rejection rejection);
+
+struct InferenceRequest {
+  std::string_view image;  // encoded JPEG/PNG; must stay valid until the completion has run
+  DetectOptions options;
+  bool encode_map_png = true;
+  std::optional<std::chrono::steady_clock::time_point> deadline;
+};
+
+struct InferenceResult {
+  Status status;
+  Rejection rejection = Rejection::kNone;
+  Detection detection;                       // valid when status.ok()
+  std::string map_png;                       // when requested and status.ok()
+  std::shared_ptr<const LoadedModel> model;  // the model that served the request
+  StageTimes timings;                        // "queue", "decode", pipeline stages, "encode_map"
+  double total_ms = 0;                       // submission to completion
+};
+
+using Completion = std::function<void(InferenceResult)>;
+
+struct EngineConfig {
+  int workers = 1;
+  int queue_capacity = 16;  // requests waiting (not counting the ones running)
+  ImageLimits limits;
+  int max_proposals_cap = 10000;  // options above this are refused
+};
+
+class InferenceEngine {
+ public:
+  // `models` and `metrics` (nullable) must outlive the engine.
+  InferenceEngine(EngineConfig config, const ModelHolder& models, ServerMetrics* metrics);
+  ~InferenceEngine();
+  InferenceEngine(const InferenceEngine&) = delete;
+  InferenceEngine& operator=(const InferenceEngine&) = delete;
+
+  void Start();
+  // Runs `done` exactly once: inline when the request is refused at admission, otherwise on a
+  // worker thread.
+  void Submit(const InferenceRequest& request, Completion done);
+
+  // A model is loaded and the engine is not draining.
+  bool Ready() const;
+  // From now on every new request is refused with UNAVAILABLE; queued ones still run.
+  void BeginDrain();
+  bool draining() const;
+  // Waits until nothing is queued or running; false when `deadline` came first.
+  bool WaitIdle(std::chrono::steady_clock::time_point deadline);
+  // Requests still queued complete with UNAVAILABLE; running ones finish; workers are joined.
+  void Stop();
+
+  size_t queue_depth() const;
+  const EngineConfig& config() const { return config_; }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct Job {
+    InferenceRequest request;
+    Completion done;
+    Clock::time_point submitted;
+  };
+
+  void WorkerLoop();
+  InferenceResult Run(const Job& job) const;
+  void Finish(Completion& done, InferenceResult result, Clock::time_point submitted) const;
+  Status ValidateOptions(const DetectOptions& options) const;
+
+  const EngineConfig config_;
+  const ModelHolder& models_;
+  ServerMetrics* const metrics_;
+
+  mutable std::mutex mutex_;  // guards everything below
+  std::condition_variable work_available_;
+  std::condition_variable idle_;
+  std::deque<Job> queue_;
+  int running_ = 0;
+  bool draining_ = false;
+  bool stopping_ = false;
+  std::vector<std::thread> workers_;
+};
+
+}  // namespace tod::server

@@ -1,0 +1,87 @@
+#include "server/detect_response.h"
+
+#include <google/protobuf/util/json_util.h>
+
+namespace tod::server {
+namespace {
+
+void FillBox(const Box& box, tod::v1::Box* out) {
+  out->set_x(box.x);
+  out->set_y(box.y);
+  out->set_w(box.w);
+  out->set_h(box.h);
+}
+
+}  // namespace
+
+RequestOptions OptionsFromProto(const tod::v1::DetectOptions& options) {
+  RequestOptions out;
+  if (options.has_max_proposals()) out.detect.max_proposals = options.max_proposals();
+  if (options.has_obstacle_threshold()) {
+    out.detect.obstacle_threshold = options.obstacle_threshold();
+  }
+  out.encode_map_png = options.map_format() != tod::v1::MAP_FORMAT_NONE;
+  out.detect.want_probability_map = out.encode_map_png;
+  return out;
+}
+
+void FillDetectResponse(const InferenceResult& result, const std::string& frame_id,
+                        tod::v1::DetectResponse* response) {
+  const Detection& detection = result.detection;
+  response->set_frame_id(frame_id);
+  if (result.model) response->set_model_version(result.model->detector->info().version);
+  response->set_width(detection.width);
+  response->set_height(detection.height);
+  for (const DetectedObstacle& obstacle : detection.obstacles) {
+    tod::v1::Obstacle* out = response->add_obstacles();
+    FillBox(obstacle.box, out->mutable_box());
+    out->set_area(static_cast<int32_t>(obstacle.area));
+    out->set_peak_probability(obstacle.peak_probability);
+    out->set_mean_probability(obstacle.mean_probability);
+  }
+  for (const Proposal& proposal : detection.proposals) {
+    tod::v1::Proposal* out = response->add_proposals();
+    FillBox(proposal.box, out->mutable_box());
+    out->set_fused(proposal.fused);
+    out->set_ordr(proposal.ordr);
+    out->set_obdr(proposal.obdr);
+  }
+  if (!result.map_png.empty()) {
+    tod::v1::ProbabilityMap* map = response->mutable_probability_map();
+    map->set_width(detection.probability.cols);
+    map->set_height(detection.probability.rows);
+    map->set_png(result.map_png);
+  }
+  for (const auto& [stage, ms] : result.timings) {
+    tod::v1::StageTiming* timing = response->add_timings();
+    timing->set_stage(stage);
+    timing->set_ms(ms);
+  }
+  response->set_total_ms(result.total_ms);
+}
+
+void FillModelInfo(const LoadedModel& model, tod::v1::ModelInfo* info) {
+  const ModelInfo& bundle = model.detector->info();
+  info->set_name(bundle.name);
+  info->set_version(bundle.version);
+  info->set_format_version(bundle.format_version);
+  info->set_created(bundle.created);
+  info->set_trained_on(bundle.trained_on);
+  info->set_edge_source(bundle.edge_source);
+  info->set_manifest_json(bundle.manifest.dump());
+  info->set_model_dir(model.model_dir);
+  info->set_generation(model.generation);
+  info->set_loaded_at(model.loaded_at);
+}
+
+std::string MessageToJson(const google::protobuf::Message& message) {
+  google::protobuf::util::JsonPrintOptions options;
+  options.preserve_proto_field_names = true;
+  options.always_print_primitive_fields = true;
+  std::string json;
+  // Printing a valid message cannot fail; an empty object is the safe fallback.
+  if (!google::protobuf::util::MessageToJsonString(message, &json, options).ok()) json = "{}";
+  return json;
+}
+
+}  // namespace tod::server

@@ -1,0 +1,96 @@
+#include "server/metrics.h"
+
+#include <prometheus/text_serializer.h>
+
+namespace tod::server {
+namespace {
+
+// Seconds; spans a fast small frame (ms) to a full-size frame of the paper's pipeline (~10 s).
+prometheus::Histogram::BucketBoundaries LatencyBuckets() {
+  return {0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10, 30};
+}
+
+}  // namespace
+
+ServerMetrics::ServerMetrics()
+    : registry_(std::make_shared<prometheus::Registry>()),
+      requests_(prometheus::BuildCounter()
+                    .Name("tod_requests_total")
+                    .Help("Finished requests by protocol and gRPC status code")
+                    .Register(*registry_)),
+      request_duration_(prometheus::BuildHistogram()
+                            .Name("tod_request_duration_seconds")
+                            .Help("Admission to response, by protocol")
+                            .Register(*registry_)),
+      queue_duration_(prometheus::BuildHistogram()
+                          .Name("tod_queue_duration_seconds")
+                          .Help("Time a request waited in the queue for a worker")
+                          .Register(*registry_)
+                          .Add({}, LatencyBuckets())),
+      stage_duration_(prometheus::BuildHistogram()
+                          .Name("tod_stage_duration_seconds")
+                          .Help("Per-stage processing time (decode, pipeline stages, encode)")
+                          .Register(*registry_)),
+      queue_depth_(prometheus::BuildGauge()
+                       .Name("tod_queue_depth")
+                       .Help("Requests waiting for a worker")
+                       .Register(*registry_)
+                       .Add({})),
+      in_flight_(prometheus::BuildGauge()
+                     .Name("tod_in_flight_requests")
+                     .Help("Requests admitted and not yet answered (queued or running)")
+                     .Register(*registry_)
+                     .Add({})),
+      rejections_(prometheus::BuildCounter()
+                      .Name("tod_rejections_total")
+                      .Help("Requests refused, by reason")
+                      .Register(*registry_)),
+      model_info_(prometheus::BuildGauge()
+                      .Name("tod_model_info")
+                      .Help("The model serving (value 1), labelled with name, version, generation")
+                      .Register(*registry_)),
+      reloads_(prometheus::BuildCounter()
+                   .Name("tod_model_reloads_total")
+                   .Help("Model reload attempts by result")
+                   .Register(*registry_)) {}
+
+void ServerMetrics::RecordRequest(const std::string& protocol, const std::string& code,
+                                  double seconds) {
+  requests_.Add({{"protocol", protocol}, {"code", code}}).Increment();
+  request_duration_.Add({{"protocol", protocol}}, LatencyBuckets()).Observe(seconds);
+}
+
+void ServerMetrics::RecordRejection(const std::string& reason) {
+  rejections_.Add({{"reason", reason}}).Increment();
+}
+
+void ServerMetrics::ObserveQueueWait(double seconds) { queue_duration_.Observe(seconds); }
+
+void ServerMetrics::ObserveStages(const StageTimes& stages) {
+  for (const auto& [stage, ms] : stages) {
+    stage_duration_.Add({{"stage", stage}}, LatencyBuckets()).Observe(ms / 1000.0);
+  }
+}
+
+void ServerMetrics::SetQueueDepth(double depth) { queue_depth_.Set(depth); }
+
+void ServerMetrics::AddInFlight(double delta) { in_flight_.Increment(delta); }
+
+void ServerMetrics::SetModel(const std::string& name, const std::string& version, int generation) {
+  // One series only: drop the previous model's labels.
+  std::lock_guard lock(model_mutex_);
+  if (model_series_ != nullptr) model_info_.Remove(model_series_);
+  model_series_ = &model_info_.Add(
+      {{"name", name}, {"version", version}, {"generation", std::to_string(generation)}});
+  model_series_->Set(1);
+}
+
+void ServerMetrics::RecordReload(bool ok) {
+  reloads_.Add({{"result", ok ? "success" : "failure"}}).Increment();
+}
+
+std::string ServerMetrics::SerializeText() const {
+  return prometheus::TextSerializer().Serialize(registry_->Collect());
+}
+
+}  // namespace tod::server

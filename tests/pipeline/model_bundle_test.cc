@@ -1,0 +1,130 @@
+#include "core/pipeline/model_bundle.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+namespace tod {
+namespace {
+namespace fs = std::filesystem;
+
+class ModelBundleTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("tod_bundle_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static ModelBundle SmallBundle(std::uint64_t seed) {
+    ModelBundle b;
+    b.edge_kind = "gradient";
+    b.edges = CreateGradientEdgeSource();
+    b.regions = Laf2020Regions();
+    b.size_filter = SizeFilter::Laf2020();
+    std::mt19937 rng(static_cast<unsigned>(seed));
+    std::uniform_real_distribution<float> u(0, 1);
+    cv::Mat1f x(200, 20);
+    std::vector<float> y(200);
+    for (int i = 0; i < x.rows; ++i) {
+      for (int j = 0; j < 20; ++j) x(i, j) = u(rng);
+      y[i] = x(i, 0) > 0.5f ? 1.f : 0.f;
+    }
+    ForestParams fp;
+    fp.num_trees = 5;
+    fp.seed = seed;
+    b.ordr = RandomForest::Train(x, y, fp);
+    b.obdr = RandomForest::Train(x, y, fp);
+    b.version = "test";
+    b.training = {{"data", "unit test"}};
+    return b;
+  }
+  std::string Path(const std::string& name = "model") const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+TEST_F(ModelBundleTest, SaveLoadRoundTripKeepsEveryPart) {
+  const ModelBundle b = SmallBundle(3);
+  ASSERT_TRUE(SaveModelBundle(b, Path()).ok());
+  auto loaded = LoadModelBundle(Path());
+  ASSERT_TRUE(loaded.ok()) << loaded.status().ToString();
+  EXPECT_EQ(loaded->regions.layers, b.regions.layers);
+  EXPECT_EQ(loaded->edge_kind, "gradient");
+  EXPECT_EQ(loaded->version, "test");
+  EXPECT_FALSE(loaded->created.empty());
+  const float row[20] = {0.9f};
+  EXPECT_FLOAT_EQ(loaded->ordr.Predict(row), b.ordr.Predict(row));
+  EXPECT_EQ(loaded->size_filter.bands.size(), b.size_filter.bands.size());
+  // No temporary directory is left next to the bundle.
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir_)) entries += e.is_directory();
+  EXPECT_EQ(entries, 1);
+}
+
+TEST_F(ModelBundleTest, ReplacingAnExistingBundleIsAtomic) {
+  ASSERT_TRUE(SaveModelBundle(SmallBundle(1), Path()).ok());
+  ModelBundle second = SmallBundle(2);
+  second.version = "second";
+  ASSERT_TRUE(SaveModelBundle(second, Path()).ok());
+  auto loaded = LoadModelBundle(Path());
+  ASSERT_TRUE(loaded.ok());
+  EXPECT_EQ(loaded->version, "second");
+}
+
+TEST_F(ModelBundleTest, TruncatedFileIsNamed) {
+  ASSERT_TRUE(SaveModelBundle(SmallBundle(1), Path()).ok());
+  const fs::path ordr = fs::path(Path()) / "ordr.bin";
+  fs::resize_file(ordr, fs::file_size(ordr) / 2);
+  auto loaded = LoadModelBundle(Path());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.status().message().find("ordr.bin"), std::string::npos);
+  EXPECT_NE(loaded.status().message().find("truncated"), std::string::npos);
+}
+
+TEST_F(ModelBundleTest, MissingFileIsNamed) {
+  ASSERT_TRUE(SaveModelBundle(SmallBundle(1), Path()).ok());
+  fs::remove(fs::path(Path()) / "occlusion.bin");
+  auto loaded = LoadModelBundle(Path());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.status().message().find("occlusion.bin"), std::string::npos);
+  EXPECT_NE(loaded.status().message().find("missing"), std::string::npos);
+}
+
+TEST_F(ModelBundleTest, WrongFormatVersionAndBrokenManifestAreRefused) {
+  ASSERT_TRUE(SaveModelBundle(SmallBundle(1), Path()).ok());
+  const fs::path manifest = fs::path(Path()) / "manifest.json";
+  std::ifstream in(manifest);
+  nlohmann::json j = nlohmann::json::parse(in);
+  in.close();
+  j["format_version"] = 99;
+  std::ofstream(manifest) << j.dump();
+  auto loaded = LoadModelBundle(Path());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.status().message().find("format_version 99"), std::string::npos);
+  std::ofstream(manifest) << "{ not json";
+  loaded = LoadModelBundle(Path());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.status().message().find("manifest.json"), std::string::npos);
+}
+
+TEST_F(ModelBundleTest, MissingDirectory) {
+  auto loaded = LoadModelBundle(Path("nowhere"));
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().code(), StatusCode::kNotFound);
+}
+
+TEST_F(ModelBundleTest, EvalNumbersAreAddedToTheManifest) {
+  ASSERT_TRUE(SaveModelBundle(SmallBundle(1), Path()).ok());
+  ASSERT_TRUE(UpdateManifestEval(Path(), {{"frames", 3}}).ok());
+  auto loaded = LoadModelBundle(Path());
+  ASSERT_TRUE(loaded.ok());
+  EXPECT_EQ(loaded->eval["frames"], 3);
+}
+
+}  // namespace
+}  // namespace tod

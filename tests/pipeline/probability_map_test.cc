@@ -1,0 +1,81 @@
+#include "core/pipeline/probability_map.h"
+
+#include <gtest/gtest.h>
+
+namespace tod {
+namespace {
+
+TEST(FuseScores, TopHalfByOrdrGetsOrdrPlusWeightedObdr) {
+  const std::vector<float> ordr = {0.9f, 0.1f, 0.5f, 0.3f};
+  const std::vector<float> obdr = {1.0f, 1.0f, 0.5f, 1.0f};
+  const std::vector<float> fused = FuseScores(ordr, obdr);
+  EXPECT_FLOAT_EQ(fused[0], 0.9f + 0.3f * 1.0f);
+  EXPECT_FLOAT_EQ(fused[2], 0.5f + 0.3f * 0.5f);
+  EXPECT_FLOAT_EQ(fused[1], 0.f);  // bottom half gated out even with a high OBDR
+  EXPECT_FLOAT_EQ(fused[3], 0.f);
+}
+
+TEST(FuseScores, OddCountKeepsFloorOfHalfAndTiesAreStable) {
+  const std::vector<float> ordr = {0.5f, 0.5f, 0.5f};
+  const std::vector<float> fused = FuseScores(ordr, {0.f, 0.f, 0.f});
+  EXPECT_FLOAT_EQ(fused[0], 0.5f);  // floor(1.5) = 1 box kept: the first of the tie
+  EXPECT_FLOAT_EQ(fused[1], 0.f);
+  EXPECT_FLOAT_EQ(fused[2], 0.f);
+}
+
+// Brute force of §7 for comparison: accumulate each kept box pixel by pixel.
+cv::Mat1f BruteForceMap(const std::vector<ScoredBox>& kept_top, cv::Size size) {
+  cv::Mat1f m(size, 0.f);
+  for (const auto& b : kept_top) m(ClipToImage(b.box, size.width, size.height).rect()) += b.score;
+  double peak;
+  cv::minMaxLoc(m, nullptr, &peak);
+  if (peak > 0) m /= peak;
+  return m;
+}
+
+TEST(ProbabilityMap, MatchesBruteForceAccumulationAndPeaksOnTheObstacle) {
+  // Four disjoint boxes above 0.25 (two of them overlapping heavily -> one removed by NMS 0.7).
+  std::vector<ScoredBox> boxes = {{{10, 10, 10, 10}, 0.9f},
+                                  {{11, 10, 10, 10}, 0.8f},  // IoU 0.82 with the first: removed
+                                  {{40, 5, 8, 8}, 0.7f},
+                                  {{5, 30, 12, 6}, 0.6f},
+                                  {{30, 30, 5, 5}, 0.5f},
+                                  {{0, 0, 64, 48}, 0.2f}};  // below 0.25: dropped
+  const cv::Mat1f map = AccumulateProbabilityMap(boxes, {64, 48});
+  // Kept after NMS: 0.9, 0.7, 0.6, 0.5 -> top half = the 0.9 and 0.7 boxes.
+  const cv::Mat1f expected = BruteForceMap({boxes[0], boxes[2]}, {64, 48});
+  EXPECT_LT(cv::norm(map, expected, cv::NORM_INF), 1e-5);
+  EXPECT_FLOAT_EQ(map(15, 15), 1.f);
+  EXPECT_NEAR(map(8, 44), 0.7f / 0.9f, 1e-5);
+  EXPECT_FLOAT_EQ(map(33, 10), 0.f);
+}
+
+TEST(ProbabilityMap, NoBoxesGiveAnAllZeroMap) {
+  const cv::Mat1f map = AccumulateProbabilityMap({}, {16, 8});
+  EXPECT_EQ(cv::countNonZero(map), 0);
+}
+
+TEST(ProbabilityMap, ThresholdedComponentsCarryBoxAreaPeakAndMean) {
+  cv::Mat1f p(20, 30, 0.f);
+  p(cv::Rect(2, 3, 4, 5)) = 0.8f;
+  p(4, 3) = 1.0f;
+  p(cv::Rect(20, 10, 3, 3)) = 0.6f;
+  const auto comps = ThresholdObstacles(p, 0.5f);
+  ASSERT_EQ(comps.size(), 2u);
+  EXPECT_EQ(comps[0].box, (Box{2, 3, 4, 5}));
+  EXPECT_EQ(comps[0].area, 20);
+  EXPECT_FLOAT_EQ(comps[0].peak, 1.0f);
+  EXPECT_NEAR(comps[0].mean, (19 * 0.8 + 1.0) / 20, 1e-6);
+  EXPECT_EQ(comps[1].box, (Box{20, 10, 3, 3}));
+  EXPECT_TRUE(ThresholdObstacles(p, 1.0f).empty());
+}
+
+TEST(RankedAboveThreshold, StrictAndSorted) {
+  const auto r = RankedAboveThreshold({{{0, 0, 1, 1}, 0.25f}, {{1, 1, 1, 1}, 0.3f}, {{2, 2, 1, 1}, 0.9f}}, 0.25f);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_FLOAT_EQ(r[0].score, 0.9f);
+  EXPECT_FLOAT_EQ(r[1].score, 0.3f);
+}
+
+}  // namespace
+}  // namespace tod

@@ -1,0 +1,68 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/proposals/edge_box_scorer.h"
+
+namespace tod {
+namespace {
+
+TEST(NmsTest, RemovesAboveThresholdKeepsExactlyAtThreshold) {
+  // A = 4x4; E = 5x4 containing A: IoU 16 / 20 = 0.8 > 0.75 -> removed.
+  // B = 4x3 inside A: IoU 12 / 16 = 0.75 exactly -> kept; B vs E = 12 / 20, irrelevant.
+  const ScoredBox a{{0, 0, 4, 4}, 0.9f}, e{{0, 0, 5, 4}, 0.8f}, b{{0, 0, 4, 3}, 0.7f};
+  const auto kept = NonMaximumSuppression({b, e, a}, 0.75f, 100);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_EQ(kept[0].box, a.box);
+  EXPECT_EQ(kept[1].box, b.box);
+}
+
+TEST(NmsTest, MaxBoxesAndDegenerateInputs) {
+  std::vector<ScoredBox> boxes;
+  for (int i = 0; i < 10; ++i) boxes.push_back({{i * 10, 0, 5, 5}, static_cast<float>(i)});
+  const auto kept = NonMaximumSuppression(boxes, 0.75f, 3);
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_EQ(kept[0].score, 9.f);
+  EXPECT_EQ(kept[2].score, 7.f);
+  EXPECT_TRUE(NonMaximumSuppression({}, 0.75f, 3).empty());
+  EXPECT_TRUE(NonMaximumSuppression(boxes, 0.75f, 0).empty());
+  // Empty boxes never overlap anything.
+  EXPECT_EQ(NonMaximumSuppression({{{0, 0, 0, 0}, 1.f}, {{0, 0, 0, 0}, 0.5f}}, 0.75f, 5).size(),
+            2u);
+}
+
+// Plain O(n^2) greedy NMS as the reference for the binned version.
+std::vector<ScoredBox> Reference(std::vector<ScoredBox> boxes, float thr, int max_boxes) {
+  std::stable_sort(boxes.begin(), boxes.end(),
+                   [](const ScoredBox& a, const ScoredBox& b) { return a.score > b.score; });
+  std::vector<ScoredBox> kept;
+  for (const ScoredBox& c : boxes) {
+    if (static_cast<int>(kept.size()) >= max_boxes) break;
+    bool keep = true;
+    for (const ScoredBox& k : kept) keep = keep && BoxIoU(c.box, k.box) <= thr;
+    if (keep) kept.push_back(c);
+  }
+  return kept;
+}
+
+TEST(NmsTest, BinnedNmsEqualsPlainGreedyNms) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> pos(0, 40), size(1, 30), score(0, 50);
+  for (const float thr : {0.3f, 0.5f, 0.75f, 0.9f}) {
+    std::vector<ScoredBox> boxes;
+    for (int i = 0; i < 1500; ++i) {
+      boxes.push_back({{pos(rng), pos(rng), size(rng), size(rng)},
+                       static_cast<float>(score(rng))});  // many ties
+    }
+    const auto expected = Reference(boxes, thr, 400);
+    const auto got = NonMaximumSuppression(boxes, thr, 400);
+    ASSERT_EQ(got.size(), expected.size()) << thr;
+    for (size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i].box, expected[i].box) << thr << " " << i;
+      EXPECT_EQ(got[i].score, expected[i].score);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace tod
