@@ -4,55 +4,75 @@
 //  5 mean edge, 6 edge density, 7 normalised area, 8 aspect ratio, 9 objectness,
 //  10 X centre, 11 Y centre, 12 width, 13 height (full-image coordinates / actual image size),
 //  14-16 H/S/V standard deviation, 17-19 H/S/V contrast against the surround ring.
+//
+// Cost model (1800 x 620 region): construction is one pass over the edge map (sparse rows,
+// sparse_edge_map.h) plus, unless a frame-wide ColourIntegrals is shared, one pass over the colour
+// crop (colour_integrals.h); about 15 B/pixel in all instead of the 250 B/pixel of full-resolution
+// integral histograms. Per box: features 0-6 scan the box's rows (O(height + edge pixels));
+// 14-19 are coarse-grid lookups plus a scan of the strips (under 4 px wide) around them.
+//
+// Everything is exact except one documented approximation, on by default: the colour contrast
+// (17-19) of a LARGE box (grown box >= contrast_snap_min_area pixels, box sides >= 8) counts the
+// box and the grown box with their sides moved to the nearest multiple of 4 (full-image
+// coordinates; sides on the region border stay put). That moves each side by at most 2 px on a
+// box at least ~64 px across, which the cosine distance barely notices, and saves the strip scans.
 #pragma once
 
 #include <array>
-#include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
 
 #include "core/base/status.h"
 #include "core/base/types.h"
+#include "core/features/colour_integrals.h"
+#include "core/features/hsv.h"  // BgrToHsv, HueBin, SatValBin, kHueBins, kSatValBins, ...
+#include "core/features/sparse_edge_map.h"
 
 namespace tod {
 
 inline constexpr int kNumBoxFeatures = 20;
 using BoxFeatureVector = std::array<float, kNumBoxFeatures>;
 
-// Histogram layout of the colour-contrast features (ALGORITHM.md §5, features 18-20).
-inline constexpr int kHueBins = 16;     // 17 non-uniform edges, last bin merged into the first
-inline constexpr int kSatValBins = 16;  // uniform, width 1/16; 1.0 falls in the last bin
-inline constexpr int kColourHistBins = kHueBins + 2 * kSatValBins;  // 48: H, then S, then V
-
 struct BoxFeatureOptions {
   // ALGORITHM.md §5 "coordinates quirk": the original code computed features 10-11 from
   // region-relative box coordinates. Off by default (full-image coordinates, [R]); the flag
   // exists to reproduce models trained the old way. Features 12-13 do not depend on it.
   bool region_relative_centre = false;
+  // Colour contrast of large boxes (see the top of this file). exact_contrast = true counts every
+  // histogram exactly (slower on large boxes, same values on small ones).
+  bool exact_contrast = false;
+  int contrast_snap_min_area = 64 * 64;  // grown-box pixels from which snapping applies
 };
-
-// MATLAB rgb2hsv of one 8-bit BGR pixel: H, S, V all in [0, 1], H linear (not circular).
-cv::Vec3f BgrToHsv(const cv::Vec3b& bgr);
-// Hue histogram bin (0..15) of a hue given in degrees [0, 360).
-int HueBin(double hue_degrees);
-// Saturation / value histogram bin (0..15) of a value in [0, 1].
-int SatValBin(float value);
 
 class BoxFeatureExtractor {
  public:
   // region_map: occlusion edge map of the region crop; region_bgr: colour crop of the same size;
   // region_origin: crop's top-left in the full image; image_size: full frame size.
-  // Builds all integral images once, so each box costs O(1) except features 0-2.
+  // Builds the colour tables of this crop itself; prefer the shared form below when several
+  // regions of one frame are measured.
   // On invalid input (sizes differ, crop outside the frame, non-finite map values) the extractor
   // is empty, status() says why, and Compute() returns zeros except the objectness.
   BoxFeatureExtractor(const cv::Mat1f& region_map, const cv::Mat3b& region_bgr,
                       cv::Point region_origin, cv::Size image_size,
                       const BoxFeatureOptions& options = {});
 
-  // Same as the constructor, but invalid input is an error instead of an empty extractor.
+  // Shares the colour tables of a larger crop (normally R1) that contains this region, so a
+  // frame converts and integrates its colours once for all its regions. frame_colour->origin()
+  // locates that crop in the full image; the region [region_origin, + region_map.size()) must lie
+  // inside it. The surround ring of features 17-19 is still clipped to this region. Gives the
+  // same features as the constructor above on the same region (up to double rounding in 14-16).
+  BoxFeatureExtractor(std::shared_ptr<const ColourIntegrals> frame_colour,
+                      const cv::Mat1f& region_map, cv::Point region_origin, cv::Size image_size,
+                      const BoxFeatureOptions& options = {});
+
+  // Same as the constructors, but invalid input is an error instead of an empty extractor.
   static Result<BoxFeatureExtractor> Create(const cv::Mat1f& region_map,
                                             const cv::Mat3b& region_bgr, cv::Point region_origin,
+                                            cv::Size image_size,
+                                            const BoxFeatureOptions& options = {});
+  static Result<BoxFeatureExtractor> Create(std::shared_ptr<const ColourIntegrals> frame_colour,
+                                            const cv::Mat1f& region_map, cv::Point region_origin,
                                             cv::Size image_size,
                                             const BoxFeatureOptions& options = {});
 
@@ -65,31 +85,17 @@ class BoxFeatureExtractor {
   cv::Mat1f ComputeAll(const std::vector<ScoredBox>& proposals) const;
 
  private:
-  // Sums of the 48 histogram integrals over a region-local box.
-  std::array<int, kColourHistBins> HistogramOf(const cv::Rect& local) const;
+  // Validates, then builds the sparse edge map; leaves the extractor empty on error.
+  void Init(const cv::Mat1f& region_map);
 
   Status status_;
   BoxFeatureOptions options_;
-  // Features 1-3 visit only the edge pixels of a box: the non-zero pixels of M row by row
-  // (compressed sparse rows), each stored as the rank of its value among the distinct non-zero
-  // values, so the mode is a counting pass instead of a sort. Replaces the former dense
-  // `cv::Mat1f map_` copy (the map itself is not needed after construction).
-  cv::Size region_size_;
-  std::vector<int> edge_row_start_;  // rows + 1 offsets into the two arrays below
-  std::vector<int> edge_cols_;       // column of each edge pixel, ascending within a row
-  std::vector<int> edge_ranks_;      // index into edge_values_
-  std::vector<float> edge_values_;   // distinct non-zero values of M, ascending
+  cv::Size region_size_;  // (0, 0) when empty: every box then misses the region
   cv::Point origin_;
   cv::Size image_size_;
-  cv::Mat1d map_sum_;    // integral of M
-  cv::Mat1i map_count_;  // integral of M > 0
-  std::array<cv::Mat1d, 3> hsv_sum_;
-  std::array<cv::Mat1d, 3> hsv_sq_sum_;
-  // 48 histogram integrals (16 H bins, 16 S bins, 16 V bins), stored interleaved: entry
-  // ((y * (cols + 1)) + x) * 48 + bin. One box corner then reads 48 adjacent ints instead of
-  // touching 48 separate images (the former std::vector<cv::Mat1i>; same content). Allocated
-  // without zero-filling: every entry is written exactly once by the constructor.
-  std::unique_ptr<std::int32_t[]> hist_integrals_;
+  SparseEdgeMap edges_;
+  std::shared_ptr<const ColourIntegrals> colour_;
+  cv::Rect region_in_colour_;  // the region in colour_'s crop coordinates
 };
 
 }  // namespace tod

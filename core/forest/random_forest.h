@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/forest/compact_forest.h"
+#include "core/forest/forest_node.h"
 
 namespace tod {
 
@@ -39,7 +41,14 @@ class RandomForest {
   // row must hold num_features() values. An empty forest predicts 0.
   float Predict(const float* row) const;
   // One prediction per row; empty when features.cols != num_features() (for a non-empty forest).
+  // Bit-identical to calling Predict on every row, and much faster for many rows (see
+  // compact_forest.h). Single-threaded; safe to call concurrently.
   std::vector<float> PredictBatch(const cv::Mat1f& features) const;
+  // One prediction per entry of `subset` (row indices into features, any order, repeats
+  // allowed), equal to Predict(features[subset[k]]); the other rows are not read. Empty when
+  // features.cols != num_features() (for a non-empty forest) or an index is outside
+  // [0, features.rows).
+  std::vector<float> PredictBatch(const cv::Mat1f& features, const std::vector<int>& subset) const;
 
   int num_features() const { return num_features_; }
   int num_trees() const { return static_cast<int>(tree_roots_.size()); }
@@ -54,19 +63,24 @@ class RandomForest {
   static Result<RandomForest> Load(std::istream& in, const std::string& what);
 
  private:
-  // 12 bytes per node; the two children of a split are adjacent (right = left + 1), so one
-  // index suffices, and children always come after their parent (which is what makes a loaded
-  // forest provably acyclic).
-  struct Node {
-    std::int32_t feature = -1;  // -1 = leaf
-    float value = 0.f;          // split: threshold (go left when x[feature] <= value); leaf: mean
-    std::int32_t left = -1;     // index into nodes_ of the left child; right child = left + 1
-  };
+  // See forest_node.h: 12 bytes, children adjacent (right = left + 1) and after their parent.
+  using Node = ForestNode;
   friend class ForestTreeBuilder;
+
+  // Sums the trees' outputs for `count` rows (tree order per row, as Predict) and writes the
+  // means to out[0, count).
+  void PredictRows(const float* const* rows, int count, float* out) const;
+  // How many rows PredictRows walks through one tree before moving to the next.
+  int BlockRows() const;
+  // Rebuilds compact_ from nodes_ and tree_roots_; called whenever those change.
+  void PackForPrediction();
 
   int num_features_ = 0;
   std::vector<Node> nodes_;               // all trees, one after another
   std::vector<std::int32_t> tree_roots_;  // index of each tree's root in nodes_
+  // The same trees packed for PredictBatch; empty (and nodes_ is walked instead) only when a
+  // forest has too many nodes to pack.
+  CompactForest compact_;
 };
 
 }  // namespace tod

@@ -220,6 +220,7 @@ Result<RandomForest> RandomForest::Load(std::istream& in, const std::string& wha
   const std::uint64_t stored_hash = r.Unsigned(8);
   if (!r.ok()) return truncated("the checksum");
   if (stored_hash != expected_hash) return corrupt("checksum mismatch (the data is corrupt)");
+  forest.PackForPrediction();
   return forest;
 }
 

@@ -30,7 +30,14 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   const cv::Mat1f features = ComputeProposalFeatures(image, oaocc, regions, proposals);
   if (timer) timer->Mark("features");
   out.ordr = bundle.ordr.PredictBatch(features);
-  out.obdr = bundle.obdr.PredictBatch(features);
+  // OBDR only matters for the boxes that pass the fusion gate (top keep_ratio by ORDR, §6.5), so
+  // only those are scored; the rest keep OBDR 0.
+  const std::vector<int> gated = GatedByOrdr(out.ordr, bundle.params.fusion);
+  cv::Mat1f gated_rows(static_cast<int>(gated.size()), features.cols);
+  for (std::size_t r = 0; r < gated.size(); ++r) features.row(gated[r]).copyTo(gated_rows.row(static_cast<int>(r)));
+  const std::vector<float> gated_obdr = bundle.obdr.PredictBatch(gated_rows);
+  out.obdr.assign(out.ordr.size(), 0.f);
+  for (std::size_t r = 0; r < gated.size() && r < gated_obdr.size(); ++r) out.obdr[gated[r]] = gated_obdr[r];
   if (timer) timer->Mark("regression");
   out.proposals = std::move(proposals);
   return out;

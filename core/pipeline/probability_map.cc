@@ -9,19 +9,19 @@
 
 namespace tod {
 
+std::vector<int> GatedByOrdr(const std::vector<float>& ordr, const FusionParams& params) {
+  std::vector<int> order(ordr.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return ordr[a] > ordr[b]; });
+  order.resize(static_cast<std::size_t>(params.keep_ratio * static_cast<float>(ordr.size())));
+  return order;
+}
+
 std::vector<float> FuseScores(const std::vector<float>& ordr, const std::vector<float>& obdr,
                               const FusionParams& params) {
-  const std::size_t n = ordr.size();
-  std::vector<float> fused(n, 0.f);
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return ordr[a] > ordr[b]; });
-  const std::size_t keep = static_cast<std::size_t>(params.keep_ratio * static_cast<float>(n));
-  for (std::size_t r = 0; r < keep; ++r) {
-    const std::size_t i = order[r];
-    fused[i] = ordr[i] + params.beta1 * (i < obdr.size() ? obdr[i] : 0.f);
-  }
+  std::vector<float> fused(ordr.size(), 0.f);
+  for (int i : GatedByOrdr(ordr, params))
+    fused[i] = ordr[i] + params.beta1 * (static_cast<std::size_t>(i) < obdr.size() ? obdr[i] : 0.f);
   return fused;
 }
 

@@ -14,6 +14,9 @@ struct FusionParams {
   float keep_ratio = 0.5f;  // tau_beta: the top half by ORDR passes the gate
 };
 
+// Indices of the boxes that pass the gate: the top floor(keep_ratio * n) by ORDR, stable on ties.
+std::vector<int> GatedByOrdr(const std::vector<float>& ordr, const FusionParams& params = {});
+
 // F(b) = ORDR(b) + beta1 * OBDR(b) for the top floor(keep_ratio * n) boxes by ORDR (stable
 // order on ties), 0 for the rest.
 std::vector<float> FuseScores(const std::vector<float>& ordr, const std::vector<float>& obdr,

@@ -15,15 +15,32 @@ EdgeGroupParams GroupParamsOf(const EdgeBoxParams& p) {
   return {p.edge_min_mag, p.edge_merge_thr, p.cluster_min_mag, p.gamma};
 }
 
+// NaN or infinite edge values would poison orientations, sums and finally the score order:
+// they count as "no edge".
+cv::Mat1f FiniteCopy(const cv::Mat1f& map) {
+  cv::Mat1f out = map.clone();
+  for (int r = 0; r < out.rows; ++r) {
+    float* row = out[r];
+    for (int c = 0; c < out.cols; ++c) {
+      if (!std::isfinite(row[c])) row[c] = 0.f;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 BoxScorer::BoxScorer(const cv::Mat1f& edge_map, const EdgeBoxParams& params)
+    : BoxScorer(FiniteCopy(edge_map), params, 0) {}
+
+BoxScorer::BoxScorer(const cv::Mat1f& edge_map, const EdgeBoxParams& params, int /*finite*/)
     : width_(edge_map.cols),
       height_(edge_map.rows),
       params_(params),
       refine_ratio_((1.f - params.alpha) / (1.f + params.alpha)),
       groups_(BuildEdgeGroups(edge_map, ComputeEdgeOrientation(edge_map), GroupParamsOf(params))) {
   BuildIntegralImages(edge_map);
+  bound_ = ContainmentBound(groups_, edge_map, params.edge_min_mag);
   BuildRunIndexes();
   norm_.resize(static_cast<size_t>(width_ + height_) / 2 + 2);
   norm_[0] = 0.f;  // a box narrower than 3 x 3 pixels has no inner part to normalise: score 0
@@ -115,7 +132,7 @@ double BoxScorer::RectSum(const std::vector<double>& integral, int r0, int c0, i
          integral[left + r0];
 }
 
-void BoxScorer::Score(Window& w, float bar) {
+void BoxScorer::Score(ScoreWindow& w, float bar) {
   w.score = 0.f;
   w.r0 = std::clamp(w.r0, 0, height_ - 1);
   w.r1 = std::clamp(w.r1, 0, height_ - 1);
@@ -126,16 +143,22 @@ void BoxScorer::Score(Window& w, float bar) {
   // (offset by a quarter): edges there say nothing about an object boundary (§4.2.4).
   const int half_h = (w.r1 - w.r0) / 2, half_w = (w.c1 - w.c0) / 2;
   const int inner_r0 = w.r0 + half_h / 2, inner_c0 = w.c0 + half_w / 2;
-  double v = RectSum(anchor_mag_integral_, w.r0, w.c0, w.r1, w.c1) -
-             RectSum(edge_mag_integral_, inner_r0, inner_c0, inner_r0 + half_h, inner_c0 + half_w);
+  const int inner_r1 = inner_r0 + half_h, inner_c1 = inner_c0 + half_w;
   const float norm = norm_[half_w + half_h];
+  // The containment bound ends most windows here, before the exact sums and the walk.
+  if (Hopeless(bound_.Bound(w.r0, w.c0, w.r1, w.c1, inner_r0, inner_c0, inner_r1, inner_c1), norm,
+               bar)) {
+    return;
+  }
+  double v = RectSum(anchor_mag_integral_, w.r0, w.c0, w.r1, w.c1) -
+             RectSum(edge_mag_integral_, inner_r0, inner_c0, inner_r1, inner_c1);
   // The walk can only lower v: skip it when v alone cannot score highly (or beat the bar).
   if (Hopeless(v, norm, bar)) return;
   ++past_early_exit_;
   w.score = ScoreAfterEarlyExit(w, v, norm, bar);
 }
 
-float BoxScorer::ScoreAfterEarlyExit(const Window& w, double v, float norm, float bar) {
+float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm, float bar) {
   // Groups on any of the four sides get weight 1 (they cross the box boundary); weights
   // propagate by max-product paths through the affinity graph to groups anchored inside
   // (products < 0.05 are cut), whose weighted magnitudes are subtracted from v (§4.2.4).
@@ -162,9 +185,13 @@ float BoxScorer::ScoreAfterEarlyExit(const Window& w, double v, float norm, floa
   const size_t bottom = static_cast<size_t>(w.r1) * width_;
   const size_t left = static_cast<size_t>(w.c0) * height_;
   const size_t right = static_cast<size_t>(w.c1) * height_;
+  // Check after every side: half of the walks end here, often before all four are read.
   add_boundary_runs(row_run_group_, row_run_index_[top + w.c0], row_run_index_[top + w.c1]);
+  if (Hopeless(v - removed_, norm, bar)) return 0.f;
   add_boundary_runs(row_run_group_, row_run_index_[bottom + w.c0], row_run_index_[bottom + w.c1]);
+  if (Hopeless(v - removed_, norm, bar)) return 0.f;
   add_boundary_runs(col_run_group_, col_run_index_[left + w.r0], col_run_index_[left + w.r1]);
+  if (Hopeless(v - removed_, norm, bar)) return 0.f;
   add_boundary_runs(col_run_group_, col_run_index_[right + w.r0], col_run_index_[right + w.r1]);
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
 
@@ -203,14 +230,14 @@ float BoxScorer::ScoreAfterEarlyExit(const Window& w, double v, float norm, floa
   return score < params_.min_score ? 0.f : score;
 }
 
-void BoxScorer::Refine(Window& box) {
+void BoxScorer::Refine(ScoreWindow& box) {
   // Steps from the unmodified ratio (1 - alpha) / (1 + alpha): MS changes only the grid (§4.2.7).
   int row_step = static_cast<int>(static_cast<float>(box.r1 - box.r0) * refine_ratio_);
   int col_step = static_cast<int>(static_cast<float>(box.c1 - box.c0) * refine_ratio_);
   // Tries moving one side outwards, then inwards; keeps the better window if it improves.
   // Candidates only need to beat box.score, so that is the bar for their walks.
-  auto search = [this, &box](int Window::*side, int step) {
-    Window candidate = box;
+  auto search = [this, &box](int ScoreWindow::*side, int step) {
+    ScoreWindow candidate = box;
     candidate.*side -= step;
     Score(candidate, box.score);
     if (candidate.score <= box.score) {
@@ -226,10 +253,10 @@ void BoxScorer::Refine(Window& box) {
     if (row_step <= 2 && col_step <= 2) break;
     row_step = std::max(1, row_step);
     col_step = std::max(1, col_step);
-    search(&Window::r0, row_step);   // top: grow = move up
-    search(&Window::r1, -row_step);  // bottom: grow = move down
-    search(&Window::c0, col_step);
-    search(&Window::c1, -col_step);
+    search(&ScoreWindow::r0, row_step);   // top: grow = move up
+    search(&ScoreWindow::r1, -row_step);  // bottom: grow = move down
+    search(&ScoreWindow::c0, col_step);
+    search(&ScoreWindow::c1, -col_step);
   }
 }
 

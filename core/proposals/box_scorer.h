@@ -7,28 +7,30 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/proposals/containment_bound.h"
 #include "core/proposals/edge_box_scorer.h"
 #include "core/proposals/edge_groups.h"
 
 namespace tod {
 
 // Inclusive pixel range [c0, c1] x [r0, r1], the form Edge Boxes scores.
-struct Window {
+struct ScoreWindow {
   int r0 = 0, c0 = 0, r1 = 0, c1 = 0;
   float score = 0.f;
 };
 
 class BoxScorer {
  public:
-  // edge_map normalised to max 1; params assumed valid (ValidateEdgeBoxParams).
+  // edge_map normalised to max 1 (non-finite values count as 0); params assumed valid
+  // (ValidateEdgeBoxParams).
   BoxScorer(const cv::Mat1f& edge_map, const EdgeBoxParams& params);
 
   // Clamps the window to the map and sets its score (0 when below min_score or empty). With
   // bar >= 0 the caller only asks whether the score exceeds bar: a window that provably does
   // not gets score 0 without finishing its walk; one that does gets its exact score.
-  void Score(Window& window, float bar = -1.f);
+  void Score(ScoreWindow& window, float bar = -1.f);
   // Coordinate search on the four sides with halving steps, accepting improvements.
-  void Refine(Window& window);
+  void Refine(ScoreWindow& window);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -37,6 +39,9 @@ class BoxScorer {
   long long past_early_exit() const { return past_early_exit_; }
 
  private:
+  // The real constructor, for a map already free of NaN / inf.
+  BoxScorer(const cv::Mat1f& finite_edge_map, const EdgeBoxParams& params, int finite_tag);
+
   // Per-group data the walk touches, packed into one cache line fetch.
   struct Node {
     std::uint32_t stamp = 0;  // == stamp_ when the group is in the current walk
@@ -60,12 +65,12 @@ class BoxScorer {
   void BuildWalkGraph();
   // Sum over the inclusive rectangle of a column-major (width+1) x (height+1) integral image.
   double RectSum(const std::vector<double>& integral, int r0, int c0, int r1, int c1) const;
-  bool AnchoredInside(const Node& n, const Window& w) const {
+  bool AnchoredInside(const Node& n, const ScoreWindow& w) const {
     return n.anchor_x >= w.c0 && n.anchor_x <= w.c1 && n.anchor_y >= w.r0 && n.anchor_y <= w.r1;
   }
   // The boundary-affinity walk of a clamped window whose inside magnitude v passed the early
   // exit; returns the final score (0 below min_score).
-  float ScoreAfterEarlyExit(const Window& w, double v, float norm, float bar);
+  float ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm, float bar);
   // True when a box whose remaining magnitude is v_left certainly scores below min_score or
   // not above bar. Evaluated exactly as the final score is, so early stops never disagree with
   // a finished walk; v_left only decreases during a walk and the expression is monotone in it.
@@ -98,6 +103,7 @@ class BoxScorer {
   std::vector<double> anchor_mag_integral_;  // group magnitudes placed at their anchors
   std::vector<double> edge_mag_integral_;    // M where M > edge_min_mag
   std::vector<float> norm_;                  // (bw + bh)^(-kappa), index bw + bh
+  ContainmentBound bound_;                   // skips most walks before they start
   // Runs of equal group id along each row (column): the groups touching a box side are the
   // runs between the run indexes of its two end pixels.
   std::vector<int> row_run_group_, row_run_index_;  // run_index at r * width + c

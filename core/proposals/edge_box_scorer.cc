@@ -21,7 +21,7 @@ bool Usable(const cv::Mat1f& map) {
   return !map.empty() && map.cols <= kMaxMapSide && map.rows <= kMaxMapSide;
 }
 
-Box ToBox(const Window& w) { return Box{w.c0, w.r0, w.c1 - w.c0 + 1, w.r1 - w.r0 + 1}; }
+Box ToBox(const ScoreWindow& w) { return Box{w.c0, w.r0, w.c1 - w.c0 + 1, w.r1 - w.r0 + 1}; }
 
 }  // namespace
 
@@ -46,6 +46,7 @@ Status ValidateEdgeBoxParams(const EdgeBoxParams& p) {
     return OutOfRange("stride_factor", "in (0, 1]", p.stride_factor);
   }
   if (p.min_stride < 1) return OutOfRange("min_stride", ">= 1", p.min_stride);
+  if (p.threads < 0) return OutOfRange("threads", ">= 0 (0 = all cores)", p.threads);
   return Status::Ok();
 }
 
@@ -68,7 +69,7 @@ std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxPa
     const int y_end = edge_map.rows - shape.height + shape.stride_y;
     for (int x = 0; x < x_end; x += shape.stride_x) {
       for (int y = 0; y < y_end; y += shape.stride_y) {
-        Window w{y, x, y + shape.height, x + shape.width, 0.f};
+        ScoreWindow w{y, x, y + shape.height, x + shape.width, 0.f};
         ++s.windows_visited;
         const long long past_exit_before = scorer.past_early_exit();
         scorer.Score(w);
@@ -92,7 +93,7 @@ float ScoreSingleBox(const cv::Mat1f& edge_map, const Box& box, const EdgeBoxPar
   const Box clipped = ClipToImage(box, edge_map.cols, edge_map.rows);
   if (clipped.empty()) return 0.f;
   BoxScorer scorer(edge_map, params);
-  Window w{clipped.y, clipped.x, clipped.bottom() - 1, clipped.right() - 1, 0.f};
+  ScoreWindow w{clipped.y, clipped.x, clipped.bottom() - 1, clipped.right() - 1, 0.f};
   scorer.Score(w);
   return w.score;
 }

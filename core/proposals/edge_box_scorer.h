@@ -27,6 +27,9 @@ struct EdgeBoxParams {
   float stride_factor = 1.f;     // MS: (K - k + 1) / K for region k; 1 = plain sliding window
   int min_stride = 2;            // px
   bool refine = true;
+  // Worker threads for the window grid: 1 = the calling thread only, 0 = all hardware threads.
+  // The output is identical for every value (deterministic merge, §4.2.8 NMS on a total order).
+  int threads = 1;
 };
 
 // Checks every field (ranges named in the message); ScoreEdgeBoxes returns no boxes for

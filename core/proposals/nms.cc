@@ -1,6 +1,14 @@
-// Greedy NMS with log-area bins (ALGORITHM.md §4.2.8). Exact: IoU(a, b) > t implies
-// min(area) / max(area) > t, i.e. |log area_a - log area_b| < log(1 / t), so with bins of width
-// log(1 / t) two boxes that can suppress each other are never more than one bin apart.
+// Greedy NMS with log-area bins and a position grid per bin (ALGORITHM.md §4.2.8). Both only
+// skip kept boxes that provably cannot exceed the IoU threshold t in (0, 1):
+//  * IoU(a, b) > t implies min(area) / max(area) > t, i.e. |log area_a - log area_b| < log(1 / t),
+//    so with bins of width log(1 / t) two boxes that can suppress each other are never more than
+//    one bin apart;
+//  * IoU > t needs intersection > t * max(area), so the intersection width exceeds t * w_a and
+//    t * w_b; with a left of b, x_b - x_a <= w_a - intersection width < (1 - t) w_a < (1 - t) / t
+//    w_b. Hence |x_a - x_b| < (1 - t) / t * w of either box (rows likewise), and a candidate only
+//    needs the grid cells within that radius of its top-left corner.
+// With 10 000 kept boxes the grid turns the per-candidate scan of thousands of same-size boxes
+// into a few cells.
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -10,27 +18,113 @@
 namespace tod {
 namespace {
 
-class AreaBins {
+class KeptBoxIndex {
  public:
-  explicit AreaBins(float iou_threshold) {
-    // Bins only help for thresholds in (0, 1); otherwise a single bin is plain greedy NMS.
-    if (iou_threshold > 0.f && iou_threshold < 1.f) {
-      log_step_ = std::log(1.0 / static_cast<double>(iou_threshold));
+  KeptBoxIndex(const std::vector<ScoredBox>& boxes, float iou_threshold)
+      : threshold_(iou_threshold) {
+    // The bounds only hold for thresholds in (0, 1); otherwise one flat list (plain greedy NMS).
+    if (!(iou_threshold > 0.f && iou_threshold < 1.f)) return;
+    log_step_ = std::log(1.0 / static_cast<double>(iou_threshold));
+    // Suppressed() adds 2 px of slack for the rounding of the IoU division.
+    radius_factor_ = (1.0 - iou_threshold) / iou_threshold;
+    min_x_ = min_y_ = max_x_ = max_y_ = 0;
+    bool first = true;
+    for (const ScoredBox& b : boxes) {
+      if (b.box.empty()) continue;
+      min_x_ = first ? b.box.x : std::min(min_x_, b.box.x);
+      min_y_ = first ? b.box.y : std::min(min_y_, b.box.y);
+      max_x_ = first ? b.box.x : std::max(max_x_, b.box.x);
+      max_y_ = first ? b.box.y : std::max(max_y_, b.box.y);
+      first = false;
     }
-    bins_.resize(log_step_ > 0.0 ? kBinCount : 1);
+    grids_.resize(kBinCount);
   }
-  int BinOf(const Box& b) const {
-    if (log_step_ <= 0.0 || b.area() <= 0) return 0;
-    const double bin = std::floor(std::log(static_cast<double>(b.area())) / log_step_);
-    return static_cast<int>(std::clamp(bin, 0.0, static_cast<double>(kBinCount - 1)));
+
+  // True when some kept box has IoU > threshold with the candidate.
+  bool Suppressed(const Box& candidate) const {
+    if (grids_.empty()) {
+      return std::any_of(flat_.begin(), flat_.end(),
+                         [&](const Box& k) { return BoxIoU(candidate, k) > threshold_; });
+    }
+    if (candidate.empty()) return false;  // IoU 0 with everything
+    const int bin = BinOf(candidate);
+    const long long rx = static_cast<long long>(radius_factor_ * candidate.w) + 2;
+    const long long ry = static_cast<long long>(radius_factor_ * candidate.h) + 2;
+    for (int b = std::max(0, bin - 1); b <= std::min(kBinCount - 1, bin + 1); ++b) {
+      const Grid& g = grids_[b];
+      if (g.head.empty()) continue;
+      const int gx0 = g.CellX(candidate.x - rx - min_x_), gx1 = g.CellX(candidate.x + rx - min_x_);
+      const int gy0 = g.CellY(candidate.y - ry - min_y_), gy1 = g.CellY(candidate.y + ry - min_y_);
+      for (int gx = gx0; gx <= gx1; ++gx) {
+        for (int gy = gy0; gy <= gy1; ++gy) {
+          for (int e = g.head[static_cast<size_t>(gx) * g.rows + gy]; e >= 0; e = entries_[e].next) {
+            if (BoxIoU(candidate, entries_[e].box) > threshold_) return true;
+          }
+        }
+      }
+    }
+    return false;
   }
-  int size() const { return static_cast<int>(bins_.size()); }
-  std::vector<Box>& operator[](int i) { return bins_[i]; }
+
+  void Add(const Box& kept) {
+    if (grids_.empty()) {
+      flat_.push_back(kept);
+      return;
+    }
+    if (kept.empty()) return;  // suppresses nothing
+    Grid& g = grids_[BinOf(kept)];
+    if (g.head.empty()) g = MakeGrid(BinOf(kept));
+    const size_t cell = static_cast<size_t>(g.CellX(kept.x - min_x_)) * g.rows +
+                        g.CellY(kept.y - min_y_);
+    entries_.push_back({kept, g.head[cell]});
+    g.head[cell] = static_cast<int>(entries_.size()) - 1;
+  }
 
  private:
   static constexpr int kBinCount = 4096;  // log(area) / log(1/t) stays far below this
+  static constexpr long long kMaxCells = 1 << 22;
+  struct Entry {
+    Box box;
+    int next = -1;  // next entry in the same cell
+  };
+  struct Grid {
+    long long cell = 1;  // side in pixels
+    int cols = 0, rows = 0;
+    std::vector<int> head;  // first entry per cell (column-major), -1 = none
+    int CellX(long long offset) const {
+      return static_cast<int>(std::clamp<long long>(offset / cell, 0, cols - 1));
+    }
+    int CellY(long long offset) const {
+      return static_cast<int>(std::clamp<long long>(offset / cell, 0, rows - 1));
+    }
+  };
+
+  int BinOf(const Box& b) const {
+    const double bin = std::floor(std::log(static_cast<double>(b.area())) / log_step_);
+    return static_cast<int>(std::clamp(bin, 0.0, static_cast<double>(kBinCount - 1)));
+  }
+
+  // Cells of about half the side of a square box of the bin's smallest area: a candidate then
+  // scans two or three cells per axis.
+  Grid MakeGrid(int bin) const {
+    Grid g;
+    g.cell = std::max(2LL, static_cast<long long>(0.5 * std::exp(0.5 * bin * log_step_)));
+    const long long span_x = static_cast<long long>(max_x_) - min_x_ + 1;
+    const long long span_y = static_cast<long long>(max_y_) - min_y_ + 1;
+    while ((span_x / g.cell + 1) * (span_y / g.cell + 1) > kMaxCells) g.cell *= 2;
+    g.cols = static_cast<int>(span_x / g.cell + 1);
+    g.rows = static_cast<int>(span_y / g.cell + 1);
+    g.head.assign(static_cast<size_t>(g.cols) * g.rows, -1);
+    return g;
+  }
+
+  float threshold_;
   double log_step_ = 0.0;
-  std::vector<std::vector<Box>> bins_;
+  double radius_factor_ = 0.0;
+  int min_x_ = 0, min_y_ = 0, max_x_ = 0, max_y_ = 0;  // top-left corners of the input boxes
+  std::vector<Grid> grids_;                            // per area bin; empty = flat mode
+  std::vector<Entry> entries_;
+  std::vector<Box> flat_;
 };
 
 }  // namespace
@@ -38,6 +132,8 @@ class AreaBins {
 std::vector<ScoredBox> NonMaximumSuppression(std::vector<ScoredBox> boxes, float iou_threshold,
                                              int max_boxes) {
   std::vector<ScoredBox> kept;
+  // A NaN score has no place in the order (and would break the sort): such boxes are dropped.
+  std::erase_if(boxes, [](const ScoredBox& b) { return std::isnan(b.score); });
   if (boxes.empty() || max_boxes <= 0) return kept;
   // Order: score descending, then input order (deterministic under ties). Sorting all boxes is
   // wasteful when max_boxes is reached early, so select and sort growing chunks from the front.
@@ -46,7 +142,7 @@ std::vector<ScoredBox> NonMaximumSuppression(std::vector<ScoredBox> boxes, float
   const auto before = [&boxes](int a, int b) {
     return boxes[a].score > boxes[b].score || (boxes[a].score == boxes[b].score && a < b);
   };
-  AreaBins bins(iou_threshold);
+  KeptBoxIndex index(boxes, iou_threshold);
   size_t done = 0;
   size_t chunk = std::max<size_t>(1024, 4 * static_cast<size_t>(max_boxes));
   while (done < order.size() && static_cast<int>(kept.size()) < max_boxes) {
@@ -57,18 +153,8 @@ std::vector<ScoredBox> NonMaximumSuppression(std::vector<ScoredBox> boxes, float
     std::sort(first, last, before);
     for (auto it = first; it != last && static_cast<int>(kept.size()) < max_boxes; ++it) {
       const ScoredBox& candidate = boxes[*it];
-      const int bin = bins.BinOf(candidate.box);
-      bool keep = true;
-      for (int b = std::max(0, bin - 1); keep && b <= std::min(bins.size() - 1, bin + 1); ++b) {
-        for (const Box& k : bins[b]) {
-          if (BoxIoU(candidate.box, k) > iou_threshold) {
-            keep = false;
-            break;
-          }
-        }
-      }
-      if (!keep) continue;
-      bins[bin].push_back(candidate.box);
+      if (index.Suppressed(candidate.box)) continue;
+      index.Add(candidate.box);
       kept.push_back(candidate);
     }
     done += take;

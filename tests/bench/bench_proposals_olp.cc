@@ -1,12 +1,25 @@
-// OLP box scoring speed on synthetic superpixel-boundary maps (ALGORITHM.md §8.4): thin closed
-// contours from a jittered-grid Voronoi tessellation, ~5 % of the pixels non-zero, boundary
-// strengths drawn per superpixel pair. Prints, per region size and stride factor: windows
-// visited, windows past the early exit, boxes out, median milliseconds.
+// OLP box scoring speed (ALGORITHM.md §4.2, §8.4) on the four LAF region sizes with their MS
+// stride factors, on two synthetic superpixel-boundary maps (thin closed contours of a jittered-
+// grid Voronoi tessellation, cell 40 px, ~5 % of the pixels non-zero):
+//   worst: every boundary strength uniform in [0.05, 1] - almost every boundary is an edge
+//          (> edge_min_mag 0.1), the stress case;
+//   real:  what the pipeline feeds (a trained occlusion probability normalised by its maximum):
+//          70 % of the boundary segments weak (< 0.1, below edge_min_mag), the rest 0.1 - 0.6,
+//          plus strong (0.8 - 1) closed contours around a few small objects.
+// Prints per map and region: windows visited, windows that ran the boundary-affinity walk,
+// windows with a non-zero score, all scorings that ran a walk, boxes out, median CPU and wall
+// milliseconds, and a digest of the returned boxes and scores (to check that a speed-up is exact).
+//
+// Usage: bench_proposals_olp [repeats [map [region [threads]]]]   (map / region "all" = every one)
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 #include <vector>
@@ -15,10 +28,8 @@
 
 namespace {
 
-// Voronoi labels of seeds on a jittered grid (cell size `cell`), boundaries where a pixel's
-// label differs from its right or lower neighbour.
-cv::Mat1f SuperpixelBoundaryMap(int width, int height, int cell, unsigned seed) {
-  std::mt19937 rng(seed);
+// Voronoi labels of seeds on a jittered grid (cell size `cell`).
+cv::Mat1i VoronoiLabels(int width, int height, int cell, std::mt19937& rng) {
   std::uniform_real_distribution<float> jitter(0.f, static_cast<float>(cell));
   const int gw = width / cell + 2, gh = height / cell + 2;
   std::vector<cv::Point2f> seeds(static_cast<size_t>(gw) * gh);
@@ -46,17 +57,28 @@ cv::Mat1f SuperpixelBoundaryMap(int width, int height, int cell, unsigned seed) 
       labels(y, x) = best_id;
     }
   }
-  const auto strength = [](int a, int b) {
-    const unsigned h = static_cast<unsigned>(std::min(a, b)) * 2654435761u ^
-                       static_cast<unsigned>(std::max(a, b)) * 40503u;
-    return 0.05f + 0.95f * static_cast<float>(h % 1000u) / 999.f;
-  };
-  cv::Mat1f map(height, width, 0.f);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
+  return labels;
+}
+
+// A deterministic value in [0, 1] per unordered label pair (one boundary segment), salted.
+float PairHash(int a, int b, unsigned salt) {
+  unsigned h = static_cast<unsigned>(std::min(a, b)) * 2654435761u ^
+               static_cast<unsigned>(std::max(a, b)) * 40503u ^ salt * 97u;
+  h ^= h >> 13;
+  h *= 0x5bd1e995u;
+  h ^= h >> 15;
+  return static_cast<float>(h % 1000u) / 999.f;
+}
+
+// Boundary pixels (label differs from the right or lower neighbour) with a strength per segment.
+template <typename Strength>
+cv::Mat1f BoundaryMap(const cv::Mat1i& labels, Strength strength) {
+  cv::Mat1f map(labels.size(), 0.f);
+  for (int y = 0; y < labels.rows; ++y) {
+    for (int x = 0; x < labels.cols; ++x) {
       const int l = labels(y, x);
-      if (x + 1 < width && labels(y, x + 1) != l) map(y, x) = strength(l, labels(y, x + 1));
-      if (y + 1 < height && labels(y + 1, x) != l) {
+      if (x + 1 < labels.cols && labels(y, x + 1) != l) map(y, x) = strength(l, labels(y, x + 1));
+      if (y + 1 < labels.rows && labels(y + 1, x) != l) {
         map(y, x) = std::max(map(y, x), strength(l, labels(y + 1, x)));
       }
     }
@@ -64,7 +86,49 @@ cv::Mat1f SuperpixelBoundaryMap(int width, int height, int cell, unsigned seed) 
   return map;
 }
 
-double MedianMs(std::vector<double> v) {
+cv::Mat1f WorstCaseMap(int width, int height) {
+  std::mt19937 rng(7);
+  const cv::Mat1i labels = VoronoiLabels(width, height, 40, rng);
+  return BoundaryMap(labels, [](int a, int b) { return 0.05f + 0.95f * PairHash(a, b, 0); });
+}
+
+cv::Mat1f RealisticMap(int width, int height) {
+  std::mt19937 rng(11);
+  const cv::Mat1i labels = VoronoiLabels(width, height, 40, rng);
+  cv::Mat1f map = BoundaryMap(labels, [](int a, int b) {
+    const float u = PairHash(a, b, 1), v = PairHash(a, b, 2);
+    return u < 0.7f ? 0.01f + 0.08f * v : 0.1f + 0.5f * v * v;
+  });
+  // A few small obstacles per 10^5 px, with strong closed contours.
+  const int objects = std::max(2, width * height / 100000);
+  std::uniform_int_distribution<int> cx(20, width - 21), cy(20, height - 21), axis(4, 25);
+  std::uniform_real_distribution<float> strong(0.8f, 1.f);
+  for (int i = 0; i < objects; ++i) {
+    cv::ellipse(map, cv::Point(cx(rng), cy(rng)), cv::Size(axis(rng), axis(rng)), 0.0, 0.0, 360.0,
+                cv::Scalar(strong(rng)), 1, cv::LINE_8);
+  }
+  return map;
+}
+
+// FNV-1a over boxes and score bits: equal digests mean identical output.
+std::uint64_t Digest(const std::vector<tod::ScoredBox>& boxes) {
+  std::uint64_t h = 1469598103934665603ull;
+  const auto mix = [&h](std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) {
+      h ^= (v >> (8 * i)) & 0xffu;
+      h *= 1099511628211ull;
+    }
+  };
+  for (const tod::ScoredBox& b : boxes) {
+    std::uint32_t score_bits = 0;
+    std::memcpy(&score_bits, &b.score, sizeof score_bits);
+    for (const int v : {b.box.x, b.box.y, b.box.w, b.box.h}) mix(static_cast<std::uint32_t>(v));
+    mix(score_bits);
+  }
+  return h;
+}
+
+double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
 }
@@ -72,53 +136,60 @@ double MedianMs(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Usage: bench_proposals_olp [repeats [region name]]
   const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 3;
-  const std::string only = argc > 2 ? argv[2] : "";
+  const std::string only_map = argc > 2 ? argv[2] : "all";
+  const std::string only_region = argc > 3 ? argv[3] : "all";
+  const int threads = argc > 4 ? std::atoi(argv[4]) : 1;
   struct Region {
     const char* name;
     int width, height;
     float ms_factor;  // the region's stride factor under MS (§4.2.6)
   };
-  // LAF region sizes (§1.3) plus the 1900 x 620 target map.
-  const Region regions[] = {{"target", 1900, 620, 1.f},
-                            {"R1", 1893, 615, 1.f},
-                            {"R2", 949, 404, 0.75f},
-                            {"R3", 433, 297, 0.5f},
-                            {"R4", 341, 141, 0.25f}};
-  std::printf("%-7s %10s %7s %6s %10s %10s %8s %10s %6s %8s %8s\n", "region", "size", "factor",
-              "edge%", "windows", "past_exit", "nonzero", "scorings", "boxes", "cpu_ms", "wall_ms");
-  double ms_total = 0.0;
-  for (const Region& region : regions) {
-    if (!only.empty() && only != region.name) continue;
-    const cv::Mat1f map =
-        tod::NormaliseToMax(SuperpixelBoundaryMap(region.width, region.height, 40, 7));
-    const double edge_fraction = 100.0 * cv::countNonZero(map) / static_cast<double>(map.total());
-    std::vector<float> factors = {1.f};
-    if (region.ms_factor < 1.f) factors.push_back(region.ms_factor);
-    for (const float factor : factors) {
+  // LAF region sizes (§1.3).
+  const Region regions[] = {
+      {"R1", 1893, 615, 1.f}, {"R2", 949, 404, 0.75f}, {"R3", 433, 297, 0.5f}, {"R4", 341, 141, 0.25f}};
+  struct MapKind {
+    const char* name;
+    cv::Mat1f (*make)(int, int);
+  };
+  const MapKind maps[] = {{"real", RealisticMap}, {"worst", WorstCaseMap}};
+  std::printf("threads %d, %d repeats, medians\n", threads, repeats);
+  std::printf("%-6s %-6s %10s %6s %6s %10s %10s %8s %10s %6s %8s %8s %16s\n", "map", "region",
+              "size", "factor", "edge%", "windows", "walks", "nonzero", "scorings", "boxes",
+              "cpu_ms", "wall_ms", "digest");
+  for (const MapKind& kind : maps) {
+    if (only_map != "all" && only_map != kind.name) continue;
+    double cpu_total = 0.0, wall_total = 0.0;
+    for (const Region& region : regions) {
+      if (only_region != "all" && only_region != region.name) continue;
+      const cv::Mat1f map = tod::NormaliseToMax(kind.make(region.width, region.height));
+      const double edge_percent = 100.0 * cv::countNonZero(map > 0.1f) / double(map.total());
       tod::EdgeBoxParams params;
-      params.stride_factor = factor;
+      params.stride_factor = region.ms_factor;
+      params.threads = threads;
       tod::EdgeBoxStats stats;
-      std::vector<double> ms, cpu_ms;
+      std::uint64_t digest = 0;
+      std::vector<double> wall_ms, cpu_ms;
       for (int i = 0; i < repeats; ++i) {
         const auto t0 = std::chrono::steady_clock::now();
         const std::clock_t c0 = std::clock();
         const auto boxes = tod::ScoreEdgeBoxes(map, params, &stats);
         const std::clock_t c1 = std::clock();
         const auto t1 = std::chrono::steady_clock::now();
-        ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        wall_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
         cpu_ms.push_back(1000.0 * static_cast<double>(c1 - c0) / CLOCKS_PER_SEC);
+        digest = Digest(boxes);
       }
-      // CPU time is what the budget is about on a shared machine; wall time is shown too.
-      const double median = MedianMs(cpu_ms);
-      if (region.name[0] == 'R' && factor == region.ms_factor) ms_total += median;
-      std::printf("%-7s %5dx%-4d %7.2f %6.2f %10lld %10lld %8lld %10lld %6lld %8.1f %8.1f\n",
-                  region.name, region.width, region.height, factor, edge_fraction,
-                  stats.windows_visited, stats.windows_past_early_exit, stats.windows_nonzero,
-                  stats.scorings, stats.boxes_out, median, MedianMs(ms));
+      // CPU time is what the budget is about on a shared machine (it sums over threads).
+      cpu_total += Median(cpu_ms);
+      wall_total += Median(wall_ms);
+      std::printf("%-6s %-6s %5dx%-4d %6.2f %6.2f %10lld %10lld %8lld %10lld %6lld %8.1f %8.1f %016llx\n",
+                  kind.name, region.name, region.width, region.height, region.ms_factor,
+                  edge_percent, stats.windows_visited, stats.windows_past_early_exit,
+                  stats.windows_nonzero, stats.scorings, stats.boxes_out, Median(cpu_ms),
+                  Median(wall_ms), static_cast<unsigned long long>(digest));
     }
+    std::printf("%-6s total: %.1f ms CPU, %.1f ms wall\n", kind.name, cpu_total, wall_total);
   }
-  std::printf("4 regions with MS factors: %.1f ms CPU\n", ms_total);
   return 0;
 }

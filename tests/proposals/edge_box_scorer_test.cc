@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "tests/proposals/test_maps.h"
@@ -136,6 +137,20 @@ TEST(ScoreEdgeBoxesTest, EmptyAndTinyMapsGiveNoCrash) {
   cv::Mat1f tall(200, 3, 0.f);
   tall.col(1).setTo(1.f);
   for (const ScoredBox& b : ScoreEdgeBoxes(tall, params)) EXPECT_LE(b.box.right(), 3);
+}
+
+TEST(ScoreEdgeBoxesTest, NonFiniteEdgeValuesCountAsNoEdge) {
+  cv::Mat1f map(80, 100, 0.f);
+  DrawRectangleContour(map, 30, 20, 59, 49);
+  const auto clean = ScoreEdgeBoxes(map, EdgeBoxParams{});
+  map(5, 5) = std::nanf("");
+  map(70, 90) = std::numeric_limits<float>::infinity();
+  const auto dirty = ScoreEdgeBoxes(map, EdgeBoxParams{});
+  ASSERT_EQ(dirty.size(), clean.size());
+  for (size_t i = 0; i < clean.size(); ++i) {
+    EXPECT_EQ(dirty[i].box, clean[i].box);
+    EXPECT_EQ(dirty[i].score, clean[i].score);
+  }
 }
 
 TEST(ScoreEdgeBoxesTest, InvalidParametersAreReportedAndYieldNothing) {

@@ -66,3 +66,47 @@ TEST(NmsTest, BinnedNmsEqualsPlainGreedyNms) {
 
 }  // namespace
 }  // namespace tod
+
+namespace tod {
+namespace {
+
+TEST(NmsTest, NanScoresAreDropped) {
+  const auto kept = NonMaximumSuppression(
+      {{{0, 0, 4, 4}, std::nanf("")}, {{10, 0, 4, 4}, 0.5f}, {{20, 0, 4, 4}, 0.7f}}, 0.75f, 10);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_EQ(kept[0].score, 0.7f);
+  EXPECT_EQ(kept[1].score, 0.5f);
+}
+
+}  // namespace
+}  // namespace tod
+
+namespace tod {
+namespace {
+
+// The position grid must not lose suppressions for boxes far apart in size and place, nor for
+// negative or huge coordinates (its cells grow to fit).
+TEST(NmsTest, GridIndexEqualsPlainGreedyNmsOnWideRanges) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> pos(-300, 2000), size(1, 400), jitter(-6, 6), score(0, 200);
+  std::vector<ScoredBox> boxes;
+  for (int i = 0; i < 600; ++i) {
+    const Box base{pos(rng), pos(rng), size(rng), size(rng)};
+    for (int k = 0; k < 4; ++k) {  // near-duplicates, the case NMS exists for
+      boxes.push_back({{base.x + jitter(rng), base.y + jitter(rng), base.w + jitter(rng),
+                        base.h + jitter(rng)},
+                       static_cast<float>(score(rng))});
+    }
+  }
+  boxes.push_back({{1000000000, -1000000000, 50, 50}, 3.f});
+  boxes.push_back({{1000000002, -1000000001, 50, 51}, 2.f});  // IoU 0.92 with the one above
+  for (const float thr : {0.5f, 0.75f}) {
+    const auto expected = Reference(boxes, thr, 100000);
+    const auto got = NonMaximumSuppression(boxes, thr, 100000);
+    ASSERT_EQ(got.size(), expected.size()) << thr;
+    for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].box, expected[i].box) << thr << i;
+  }
+}
+
+}  // namespace
+}  // namespace tod

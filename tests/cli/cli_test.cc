@@ -1,0 +1,192 @@
+// End-to-end tests of the `tod` tool as a user runs it. The tiny dataset and model come from the
+// CTest fixture (tests/make_fixture.sh), made with `tod synth` and `tod train`.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/test_env.h"
+
+namespace {
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult Shell(const std::string& command) {
+  CommandResult run;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), pipe) != nullptr) run.output += buf.data();
+  const int status = ::pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    tod_ = tod::testing_env::BinDir() + "/tod";
+    data_ = tod::testing_env::TestData();
+    model_ = tod::testing_env::TestModel();
+    ASSERT_TRUE(fs::exists(tod_)) << "TOD_BIN_DIR not set or tod not built";
+    ASSERT_TRUE(fs::exists(fs::path(model_) / "manifest.json")) << "fixture model missing: " << model_;
+    out_ = fs::temp_directory_path() /
+           ("tod_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(out_);
+    fs::create_directories(out_);
+  }
+  void TearDown() override { fs::remove_all(out_); }
+
+  std::string FirstTestImage() const {
+    for (const auto& e : fs::recursive_directory_iterator(fs::path(data_) / "leftImg8bit" / "test"))
+      if (e.path().extension() == ".png") return e.path().string();
+    return "";
+  }
+  std::string tod_, data_, model_;
+  fs::path out_;
+};
+
+TEST_F(CliTest, TrainWroteACompleteManifestWithItsOwnEvalNumbers) {
+  std::ifstream in(fs::path(model_) / "manifest.json");
+  const nlohmann::json m = nlohmann::json::parse(in);
+  EXPECT_EQ(m["format_version"], 1);
+  EXPECT_EQ(m["regions"]["layers"].size(), 4u);
+  EXPECT_EQ(m["size_filter"]["bands"].size(), 3u);
+  EXPECT_EQ(m["edge_source"], "pixel_forest");
+  EXPECT_TRUE(m["params"].contains("boxes"));
+  EXPECT_GT(m["training"]["ordr_samples"].get<int>(), 100);
+  ASSERT_TRUE(m["eval"].contains("regression"));
+  EXPECT_TRUE(m["eval"]["regression"].contains("BP+Fusion@4"));
+  // No temporary directory left beside the bundle.
+  for (const auto& e : fs::directory_iterator(fs::path(model_).parent_path()))
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+TEST_F(CliTest, DetectWritesJsonMapAndOverlay) {
+  const std::string image = FirstTestImage();
+  ASSERT_FALSE(image.empty());
+  const CommandResult run = Shell(tod_ + " detect --model " + model_ + " --out " + out_.string() + " " + image);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string stem = fs::path(image).stem().string();
+  std::ifstream in(out_ / (stem + ".json"));
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["width"], 640);
+  EXPECT_EQ(j["height"], 320);
+  ASSERT_FALSE(j["proposals"].empty());
+  double previous = 1e9;
+  for (const auto& p : j["proposals"]) {
+    for (const char* key : {"x", "y", "w", "h", "score"}) EXPECT_TRUE(p.contains(key)) << key;
+    EXPECT_LE(p["score"].get<double>(), previous);
+    previous = p["score"].get<double>();
+    EXPECT_GE(p["x"].get<int>(), 0);
+    EXPECT_LE(p["x"].get<int>() + p["w"].get<int>(), 640);
+  }
+  EXPECT_TRUE(j["obstacles"].is_array());
+  for (const char* stage : {"edges", "superpixels", "occlusion", "proposals", "features",
+                            "regression", "probability_map", "total"})
+    EXPECT_TRUE(j["timing_ms"].contains(stage)) << stage;
+  const cv::Mat prob = cv::imread((out_ / (stem + "_prob.png")).string(), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(prob.empty());
+  EXPECT_EQ(prob.type(), CV_8UC1);
+  EXPECT_EQ(prob.size(), cv::Size(640, 320));
+  double peak;
+  cv::minMaxLoc(prob, nullptr, &peak);
+  EXPECT_EQ(peak, 255.0);  // the map is normalised by its maximum
+  const cv::Mat overlay = cv::imread((out_ / (stem + "_overlay.png")).string());
+  EXPECT_EQ(overlay.size(), cv::Size(640, 320));
+}
+
+TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
+  const CommandResult run = Shell(tod_ + " eval --data " + data_ + " --model " + model_ + " --json " +
+                        (out_ / "eval.json").string() + " --plots " + (out_ / "plots").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  for (const char* v : {"EB", "OLP@1", "OAOCC+OLP@1", "OAOCC+OLP@4", "OAOCC+OLP@4+MS",
+                        "OP+ORDR@4", "BP+ORDR@4", "BP+Fusion@4"})
+    EXPECT_NE(run.output.find(v), std::string::npos) << v;
+  std::ifstream in(out_ / "eval.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["frames"], 6);
+  EXPECT_GT(j["instances"].get<int>(), 0);
+  for (const char* v : {"EB", "OLP@1", "OAOCC+OLP@1", "OAOCC+OLP@4", "OAOCC+OLP@4+MS"})
+    for (const char* n : {"200", "400", "600", "800", "1000"}) {
+      const double ar = j["proposals"][v]["ar"][n].get<double>();
+      EXPECT_GE(ar, 0.0);
+      EXPECT_LE(ar, 1.0);
+    }
+  for (const char* v : {"OP+ORDR@4", "BP+ORDR@4", "BP+Fusion@4"}) {
+    for (const char* f : {"0.005", "0.010", "0.015", "0.020", "0.025", "0.030"})
+      EXPECT_TRUE(j["regression"][v]["tpr_at_fpr"].contains(f)) << v << " " << f;
+    EXPECT_TRUE(j["regression"][v]["ar"].contains("1000"));
+  }
+  EXPECT_GT(j["timing_ms"]["total"].get<double>(), 0.0);
+  for (const char* png : {"recall_vs_proposals.png", "recall_vs_iou.png", "ar_vs_proposals.png",
+                          "pixel_roc.png"})
+    EXPECT_FALSE(cv::imread((out_ / "plots" / png).string()).empty()) << png;
+}
+
+TEST_F(CliTest, BrokenModelIsRefusedWithTheFileNamed) {
+  const fs::path broken = out_ / "broken";
+  fs::copy(model_, broken, fs::copy_options::recursive);
+  fs::resize_file(broken / "obdr.bin", 10);
+  const CommandResult run = Shell(tod_ + " detect --model " + broken.string() + " --out " + out_.string() +
+                        " " + FirstTestImage());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("obdr.bin"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, UnreadableImageIsReportedAndOthersStillProcessed) {
+  const fs::path bad = out_ / "corrupt.png";
+  std::ofstream(bad) << "this is not a png";
+  const CommandResult run = Shell(tod_ + " detect --model " + model_ + " --out " + out_.string() + " " +
+                        bad.string() + " " + FirstTestImage());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("corrupt.png: not a readable image"), std::string::npos) << run.output;
+  const std::string stem = fs::path(FirstTestImage()).stem().string();
+  EXPECT_TRUE(fs::exists(out_ / (stem + ".json")));
+}
+
+TEST_F(CliTest, MissingDataAndBadFlagsGiveClearErrors) {
+  CommandResult run = Shell(tod_ + " train --data " + (out_ / "nothing").string() + " --out " +
+                  (out_ / "m").string());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("nothing"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(out_ / "m"));
+  run = Shell(tod_ + " train --data x --out y --regions nope");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  run = Shell(tod_ + " frobnicate");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+}
+
+TEST_F(CliTest, SynthIsDeterministicForASeed) {
+  for (const std::string name : {"a", "b"}) {
+    const CommandResult run = Shell(tod_ + " synth --out " + (out_ / name).string() +
+                          " --train 1 --test 0 --seed 3 --width 128 --height 64");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  const auto read = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(out_ / "a")) {
+    if (!e.is_regular_file()) continue;
+    ++files;
+    EXPECT_EQ(read(e.path()), read(out_ / "b" / fs::relative(e.path(), out_ / "a"))) << e.path();
+  }
+  EXPECT_EQ(files, 3);  // image, labelIds, instanceIds
+}
+
+}  // namespace

@@ -1,0 +1,223 @@
+// PredictBatch (both overloads) against hand-built forests whose answers are worked out by hand,
+// and against Predict on trained forests: the packed batch path must give the same floats.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/forest/random_forest.h"
+
+namespace tod {
+namespace {
+
+struct HandNode {
+  std::int32_t feature;  // -1 = leaf
+  float value;           // threshold or leaf value
+  std::int32_t left;     // -1 for a leaf
+};
+
+// Writes the documented binary format (random_forest_io.cc) for the given nodes and loads it.
+RandomForest LoadHandBuilt(int num_features, const std::vector<std::int32_t>& roots,
+                           const std::vector<HandNode>& nodes) {
+  std::string bytes("TODFRST", 8);
+  const auto put = [&bytes](std::uint64_t v, int size) {
+    for (int i = 0; i < size; ++i) bytes.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  };
+  put(1, 4);  // version
+  put(static_cast<std::uint64_t>(num_features), 4);
+  put(roots.size(), 4);
+  put(nodes.size(), 8);
+  for (const std::int32_t root : roots) put(static_cast<std::uint32_t>(root), 4);
+  for (const HandNode& node : nodes) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &node.value, sizeof bits);
+    put(static_cast<std::uint32_t>(node.feature), 4);
+    put(bits, 4);
+    put(static_cast<std::uint32_t>(node.left), 4);
+  }
+  std::uint64_t hash = 0xCBF29CE484222325ULL;
+  for (const char c : bytes) hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001B3ULL;
+  put(hash, 8);
+  std::istringstream in(bytes);
+  Result<RandomForest> loaded = RandomForest::Load(in, "hand-built");
+  EXPECT_TRUE(loaded.ok()) << loaded.status().message();
+  return loaded.ok() ? std::move(loaded).value() : RandomForest();
+}
+
+// Tree A (root 0): x0 <= 0.5 -> leaf 1; else x1 <= 0.25 -> leaf 2, else leaf 4.
+// Tree B (root 5): a single leaf 10. Tree C reuses tree A's root (shared nodes are legal).
+// So the forest predicts (a + 10 + a) / 3 with a in {1, 2, 4}.
+RandomForest ThreeTreeForest() {
+  return LoadHandBuilt(
+      2, {0, 5, 0},
+      {{0, 0.5f, 1}, {-1, 1.f, -1}, {1, 0.25f, 3}, {-1, 2.f, -1}, {-1, 4.f, -1}, {-1, 10.f, -1}});
+}
+
+float Mean3(double a) { return static_cast<float>((a + 10.0 + a) / 3.0); }
+
+TEST(BatchPrediction, HandBuiltForestGivesHandComputedValues) {
+  const RandomForest forest = ThreeTreeForest();
+  ASSERT_EQ(forest.num_trees(), 3);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  // Thresholds are inclusive on the left; NaN compares false, so it goes left everywhere.
+  const std::vector<std::pair<std::array<float, 2>, double>> cases = {
+      {{0.2f, 0.9f}, 1.0}, {{0.5f, 0.9f}, 1.0}, {{0.7f, 0.1f}, 2.0},  {{0.7f, 0.25f}, 2.0},
+      {{0.7f, 0.9f}, 4.0}, {{nan, 0.9f}, 1.0},  {{0.7f, nan}, 2.0},   {{0.7f, inf}, 4.0},
+      {{inf, -inf}, 2.0},  {{-inf, inf}, 1.0},  {{0.51f, 0.26f}, 4.0}};
+  // 3 copies of the cases: 33 rows, so several lock-step groups and a partial last one.
+  cv::Mat1f rows(3 * static_cast<int>(cases.size()), 2);
+  std::vector<float> expected;
+  for (int copy = 0; copy < 3; ++copy) {
+    for (std::size_t c = 0; c < cases.size(); ++c) {
+      const int r = copy * static_cast<int>(cases.size()) + static_cast<int>(c);
+      rows(r, 0) = cases[c].first[0];
+      rows(r, 1) = cases[c].first[1];
+      expected.push_back(Mean3(cases[c].second));
+    }
+  }
+  EXPECT_EQ(forest.PredictBatch(rows), expected);
+  for (int r = 0; r < rows.rows; ++r) EXPECT_EQ(forest.Predict(rows[r]), expected[r]) << r;
+
+  const std::vector<int> subset = {32, 0, 4, 4, 2};
+  const std::vector<float> some = forest.PredictBatch(rows, subset);
+  EXPECT_EQ(some, (std::vector<float>{Mean3(4.0), Mean3(1.0), Mean3(4.0), Mean3(4.0), Mean3(2.0)}));
+}
+
+// One tree shaped like a caterpillar: split j (node 0, then 2j - 1) tests x[j % features] > 0.5
+// and goes right to a leaf holding j, left to the next split; the last split's left leaf holds
+// -1. Its depth is splits + 1, which exercises long lock-step walks.
+RandomForest Caterpillar(int num_features, int splits) {
+  std::vector<HandNode> nodes(2 * splits + 1);
+  for (int j = 0; j < splits; ++j) {
+    const int at = j == 0 ? 0 : 2 * j - 1;
+    nodes[at] = {j % num_features, 0.5f, 2 * j + 1};
+    nodes[2 * j + 2] = {-1, static_cast<float>(j), -1};
+  }
+  nodes[2 * splits - 1] = {-1, -1.f, -1};
+  return LoadHandBuilt(num_features, {0}, nodes);
+}
+
+TEST(BatchPrediction, DeepUnbalancedTreeIsWalkedToTheEnd) {
+  const RandomForest forest = Caterpillar(4, 300);  // 601 nodes, depth 301
+  ASSERT_EQ(forest.num_nodes(), 601);
+  cv::Mat1f rows(10, 4, 0.f);  // all zeros: left all the way to -1
+  rows(1, 2) = 1.f;            // first split on feature 2 is split 2
+  rows(2, 3) = 1.f;            // split 3
+  rows(3, 0) = 0.6f;           // split 0 already goes right
+  rows(4, 1) = 0.5f;           // 0.5 is not > 0.5: never right
+  rows(5, 1) = 0.75f;          // split 1
+  rows(5, 0) = 0.75f;          // ... but split 0 comes first
+  const std::vector<float> expected = {-1.f, 2.f, 3.f, 0.f, -1.f, 0.f, -1.f, -1.f, -1.f, -1.f};
+  EXPECT_EQ(forest.PredictBatch(rows), expected);
+  EXPECT_EQ(forest.PredictBatch(rows, {4, 1}), (std::vector<float>{-1.f, 2.f}));
+}
+
+TEST(BatchPrediction, ForestTooLargeToPackStillPredictsCorrectly) {
+  // 65 537 features need 17 bits, leaving 15 for node indices (32 768 nodes): this tree of
+  // 32 771 nodes cannot be packed, so PredictBatch walks the stored nodes instead.
+  constexpr int kFeatures = 65537;
+  const RandomForest forest = Caterpillar(kFeatures, 16385);
+  ASSERT_EQ(forest.num_nodes(), 32771);
+  cv::Mat1f rows(4, kFeatures, 0.f);
+  rows(1, 7) = 1.f;
+  rows(2, 100) = 1.f;
+  rows(2, 5) = 1.f;
+  rows(3, 16384) = 1.f;  // the last split
+  const std::vector<float> expected = {-1.f, 7.f, 5.f, 16384.f};
+  EXPECT_EQ(forest.PredictBatch(rows), expected);
+  EXPECT_EQ(forest.PredictBatch(rows, {3, 3, 0}), (std::vector<float>{16384.f, 16384.f, -1.f}));
+  for (int r = 0; r < rows.rows; ++r) EXPECT_EQ(forest.Predict(rows[r]), expected[r]);
+}
+
+struct Data {
+  cv::Mat1f x;
+  std::vector<float> y;
+};
+
+Data MakeData(int rows, int cols, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<float> uniform(0.f, 1.f);
+  Data d{cv::Mat1f(rows, cols), std::vector<float>(rows)};
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) d.x(r, c) = uniform(gen);
+    d.y[r] = std::sin(5.f * d.x(r, 0)) + d.x(r, 1) * d.x(r, 2);
+  }
+  return d;
+}
+
+RandomForest DeepForest() {
+  const Data train = MakeData(400, 3, 31);
+  ForestParams p;
+  p.num_trees = 12;
+  p.max_features = 2;
+  p.min_leaf_size = 1;  // deep, unbalanced trees
+  p.threads = 1;
+  return RandomForest::Train(train.x, train.y, p);
+}
+
+TEST(BatchPrediction, ManyBlocksMatchPredictBitForBit) {
+  const RandomForest forest = DeepForest();
+  ASSERT_EQ(forest.num_trees(), 12);
+  // 5003 rows: several blocks of at least 1024 rows and a partial lock-step group at the end.
+  const Data test = MakeData(5003, 3, 32);
+  const std::vector<float> batch = forest.PredictBatch(test.x);
+  ASSERT_EQ(batch.size(), 5003u);
+  int mismatches = 0;
+  for (int r = 0; r < test.x.rows; ++r) mismatches += batch[r] != forest.Predict(test.x[r]);
+  EXPECT_EQ(mismatches, 0);
+
+  std::vector<int> subset;  // backwards, every third row, each twice
+  for (int r = test.x.rows - 1; r >= 0; r -= 3) subset.insert(subset.end(), {r, r});
+  const std::vector<float> some = forest.PredictBatch(test.x, subset);
+  ASSERT_EQ(some.size(), subset.size());
+  for (std::size_t k = 0; k < subset.size(); ++k) EXPECT_EQ(some[k], batch[subset[k]]) << k;
+}
+
+TEST(BatchPrediction, RowsMayBeAViewIntoAWiderMatrix) {
+  const RandomForest forest = DeepForest();
+  const Data wide = MakeData(50, 7, 33);
+  const cv::Mat1f view = wide.x.colRange(2, 5);  // not continuous: row stride is 7 floats
+  ASSERT_FALSE(view.isContinuous());
+  const std::vector<float> batch = forest.PredictBatch(view);
+  ASSERT_EQ(batch.size(), 50u);
+  for (int r = 0; r < view.rows; ++r) EXPECT_EQ(batch[r], forest.Predict(view[r])) << r;
+  EXPECT_EQ(forest.PredictBatch(view, {49, 0}), (std::vector<float>{batch[49], batch[0]}));
+}
+
+TEST(BatchPrediction, LoadedForestPredictsTheSameBatch) {
+  const RandomForest forest = DeepForest();
+  std::stringstream stream;
+  ASSERT_TRUE(forest.Save(stream).ok());
+  Result<RandomForest> loaded = RandomForest::Load(stream, "round trip");
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  const Data test = MakeData(300, 3, 34);
+  EXPECT_EQ(loaded.value().PredictBatch(test.x), forest.PredictBatch(test.x));
+  // A copy carries its packed form along.
+  const RandomForest copy = loaded.value();
+  EXPECT_EQ(copy.PredictBatch(test.x), forest.PredictBatch(test.x));
+}
+
+TEST(BatchPrediction, SubsetRejectsBadInput) {
+  const RandomForest forest = ThreeTreeForest();
+  const cv::Mat1f rows(4, 2, 0.f);
+  EXPECT_TRUE(forest.PredictBatch(rows, {}).empty());
+  EXPECT_TRUE(forest.PredictBatch(rows, {0, 4}).empty());               // past the last row
+  EXPECT_TRUE(forest.PredictBatch(rows, {-1}).empty());                 // negative
+  EXPECT_TRUE(forest.PredictBatch(cv::Mat1f(4, 3, 0.f), {0}).empty());  // wrong column count
+  EXPECT_EQ(forest.PredictBatch(rows, {3}), (std::vector<float>{Mean3(1.0)}));
+
+  const RandomForest untrained;  // predicts 0, as Predict does, but indices are still checked
+  EXPECT_EQ(untrained.PredictBatch(rows, {1, 1, 2}), (std::vector<float>{0.f, 0.f, 0.f}));
+  EXPECT_TRUE(untrained.PredictBatch(rows, {4}).empty());
+}
+
+}  // namespace
+}  // namespace tod
