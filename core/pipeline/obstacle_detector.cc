@@ -114,8 +114,9 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
 Result<std::shared_ptr<const Detector>> Detector::Load(const std::string& model_dir) {
   auto bundle = LoadModelBundle(model_dir);
   if (!bundle.ok()) return bundle.status();
-  const std::string name =
-      std::filesystem::path(model_dir).lexically_normal().filename().string();
+  std::filesystem::path path = std::filesystem::path(model_dir).lexically_normal();
+  if (!path.has_filename()) path = path.parent_path();  // "models/default/"
+  const std::string name = path.filename().string();
   return std::shared_ptr<const Detector>(
       std::make_shared<ObstacleDetector>(std::move(*bundle), name.empty() ? "model" : name));
 }

@@ -59,7 +59,13 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
     if (options.progress) options.progress(line);
   };
   const auto started = Clock::now();
-  auto dataset = OpenDataset(options.data_root, options.split, options.format);
+  std::string format = options.format;
+  if (format == "auto") {
+    auto detected = DetectDatasetFormat(options.data_root);
+    if (!detected.ok()) return detected.status();
+    format = *detected;
+  }
+  auto dataset = OpenDataset(options.data_root, options.split, format);
   if (!dataset.ok()) return dataset.status();
   const int total = static_cast<int>((*dataset)->size());
   const int n = options.max_frames > 0 ? std::min(total, options.max_frames) : total;
@@ -226,7 +232,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   for (long long c : proposal_counts) proposals_total += c;
   bundle.training = {
       {"data", options.data_root},
-      {"format", options.format},
+      {"format", format},
       {"split", options.split},
       {"frames", n},
       {"frame_size", {width, height}},
