@@ -1,9 +1,10 @@
 #include "core/pipeline/frame_stages.h"
 
 #include <algorithm>
-#include <optional>
+#include <memory>
 
 #include "core/features/box_features.h"
+#include "core/features/colour_integrals.h"
 
 namespace tod {
 
@@ -87,18 +88,24 @@ cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& 
                                   const MultilayerRegions& regions, const ProposalSet& proposals) {
   cv::Mat1f rows(static_cast<int>(proposals.boxes.size()), kNumBoxFeatures, 0.f);
   if (proposals.boxes.empty()) return rows;
-  // Build each region's extractor once (integral images), only for regions that produced boxes.
-  std::vector<std::optional<BoxFeatureExtractor>> extractors(regions.num_layers());
-  for (std::size_t i = 0; i < proposals.boxes.size(); ++i) {
-    const int k = proposals.layer[i];
-    if (!extractors[k]) {
-      const Box region = Intersect(regions.layers[k], oaocc.r1);
-      extractors[k].emplace(RegionEdgeMap(oaocc, regions, k), image(region.rect()),
-                            cv::Point(region.x, region.y), image.size());
-    }
-    const BoxFeatureVector f = extractors[k]->Compute(proposals.boxes[i].box,
-                                                      proposals.boxes[i].score);
-    std::copy(f.begin(), f.end(), rows.ptr<float>(static_cast<int>(i)));
+  // The colour integrals are built once for R1 and shared by every region (the regions are
+  // nested crops of R1); each region only adds its own edge map.
+  const auto frame_colour = std::make_shared<const ColourIntegrals>(
+      image(oaocc.r1.rect()), cv::Point(oaocc.r1.x, oaocc.r1.y));
+  for (int k = 0; k < regions.num_layers(); ++k) {
+    std::vector<int> members;
+    std::vector<ScoredBox> boxes;
+    for (std::size_t i = 0; i < proposals.boxes.size(); ++i)
+      if (proposals.layer[i] == k) {
+        members.push_back(static_cast<int>(i));
+        boxes.push_back(proposals.boxes[i]);
+      }
+    if (members.empty()) continue;
+    const Box region = Intersect(regions.layers[k], oaocc.r1);
+    const BoxFeatureExtractor extractor(frame_colour, RegionEdgeMap(oaocc, regions, k),
+                                        cv::Point(region.x, region.y), image.size());
+    const cv::Mat1f region_rows = extractor.ComputeAll(boxes);
+    for (std::size_t j = 0; j < members.size(); ++j) region_rows.row(static_cast<int>(j)).copyTo(rows.row(members[j]));
   }
   return rows;
 }

@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <opencv2/imgproc.hpp>
+#include <vector>
 
 namespace tod {
 namespace {
@@ -288,6 +291,255 @@ TEST(BoxFeaturesTest, InvalidInputIsAnError) {
 
   auto good = BoxFeatureExtractor::Create(cv::Mat1f(8, 8, 0.f), colour, {0, 0}, {8, 8});
   EXPECT_TRUE(good.ok());
+}
+
+// --- Fast colour classification and the shared colour tables ---------------------------------
+
+TEST(ClassifyPixelTest, BinsEqualReferenceForEveryThirdLevel) {
+  // 86^3 colours covering every channel combination of levels 0, 3, ..., 255.
+  for (int b = 0; b < 256; b += 3) {
+    for (int g = 0; g < 256; g += 3) {
+      for (int r = 0; r < 256; r += 3) {
+        const cv::Vec3b bgr(b, g, r);
+        const cv::Vec3f hsv = BgrToHsv(bgr);
+        const PixelColour c = ClassifyPixel(bgr[0], bgr[1], bgr[2]);
+        ASSERT_EQ(c.hue_bin, HueBin(hsv[0] * 360.0)) << b << " " << g << " " << r;
+        ASSERT_EQ(c.sat_bin, SatValBin(hsv[1])) << b << " " << g << " " << r;
+        ASSERT_EQ(c.val_bin, SatValBin(hsv[2])) << b << " " << g << " " << r;
+        const cv::Vec3f fast = HsvFromLevels(c.max_level, c.delta, c.hue_units);
+        ASSERT_NEAR(fast[0], hsv[0], 1e-6);
+        ASSERT_NEAR(fast[1], hsv[1], 1e-6);
+        ASSERT_EQ(fast[2], hsv[2]);
+      }
+    }
+  }
+}
+
+TEST(ClassifyPixelTest, HueExactlyOnAnEdgeFollowsTheReferenceRounding) {
+  // r = 12, g = 11, b = 0: hue = 60 * 11 / 12 = 55 degrees exactly, an edge. The reference's
+  // float H times 360 is 54.9999994, i.e. bin 3; the fast path must agree.
+  EXPECT_EQ(HueBin(BgrToHsv({0, 11, 12})[0] * 360.0), 3);
+  EXPECT_EQ(ClassifyPixel(0, 11, 12).hue_bin, 3);
+  // r = 255, g = 252, b = 251: hue = 60 * 1 / 4 = 15 degrees exactly; float rounding goes up.
+  EXPECT_EQ(HueBin(BgrToHsv({251, 252, 255})[0] * 360.0), 1);
+  EXPECT_EQ(ClassifyPixel(251, 252, 255).hue_bin, 1);
+}
+
+cv::Mat3b RandomColours(int rows, int cols, std::uint64_t seed) {
+  cv::Mat3b image(rows, cols);
+  cv::RNG rng(seed);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+  return image;
+}
+
+ColourHistogram BruteHistogram(const cv::Mat3b& image, const cv::Rect& r) {
+  ColourHistogram hist{};
+  for (int y = r.y; y < r.y + r.height; ++y) {
+    for (int x = r.x; x < r.x + r.width; ++x) {
+      const cv::Vec3f hsv = BgrToHsv(image(y, x));
+      ++hist[HueBin(hsv[0] * 360.0)];
+      ++hist[kHueBins + SatValBin(hsv[1])];
+      ++hist[kHueBins + kSatValBins + SatValBin(hsv[2])];
+    }
+  }
+  return hist;
+}
+
+TEST(ColourIntegralsTest, HistogramAndMomentsMatchBruteForce) {
+  // Origin (3, 5): the crop's own borders are not on the 4-px grid, so partial cells occur.
+  const cv::Mat3b image = RandomColours(37, 53, 99);
+  const ColourIntegrals integrals(image, {3, 5});
+  EXPECT_EQ(integrals.size(), image.size());
+  cv::RNG rng(4);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int w = rng.uniform(1, 54), h = rng.uniform(1, 38);
+    const cv::Rect r(rng.uniform(0, 54 - w), rng.uniform(0, 38 - h), w, h);
+    ASSERT_EQ(integrals.Histogram(r), BruteHistogram(image, r)) << "trial " << trial;
+    ColourMoments expected{};
+    for (int y = r.y; y < r.y + r.height; ++y) {
+      for (int x = r.x; x < r.x + r.width; ++x) {
+        const cv::Vec3f hsv = BgrToHsv(image(y, x));
+        for (int c = 0; c < 3; ++c) {
+          expected[c] += hsv[c];
+          expected[3 + c] += static_cast<double>(hsv[c]) * hsv[c];
+        }
+      }
+    }
+    const ColourMoments moments = integrals.Moments(r);
+    for (int k = 0; k < 6; ++k) ASSERT_NEAR(moments[k], expected[k], 1e-4) << "trial " << trial;
+  }
+  EXPECT_EQ(integrals.Histogram({0, 0, 0, 5}), ColourHistogram{});
+}
+
+TEST(ColourIntegralsTest, CountsAbove65535AreExact) {
+  // The corner counts are uint16 with wrap-around: a 300 x 260 uniform crop (78000 pixels) must
+  // still count every pixel, as must a rectangle of 70000 pixels.
+  const ColourIntegrals integrals(Uniform(260, 300, {255, 0, 0}), {0, 0});  // blue: H bin 10
+  const ColourHistogram all = integrals.Histogram({0, 0, 300, 260});
+  EXPECT_EQ(all[10], 78000);
+  EXPECT_EQ(all[kHueBins + 15], 78000);                // S = 1
+  EXPECT_EQ(all[kHueBins + kSatValBins + 15], 78000);  // V = 1
+  EXPECT_EQ(integrals.Histogram({1, 3, 280, 250})[10], 70000);
+}
+
+TEST(ColourIntegralsTest, SnapToGridUsesFullImageMultiplesOfFour) {
+  // Crop at full-image (3, 5): local x = 2 is global 5 -> 4 -> local 1; local x = 40 is global
+  // 43 -> 44 (ties go up) -> local 41; local y = 1 is global 6 -> 8 (tie) -> local 3;
+  // local y = 20 is global 25 -> 24 -> local 19.
+  const ColourIntegrals integrals(Uniform(30, 50, {0, 0, 0}), {3, 5});
+  const cv::Rect bounds(0, 0, 50, 30);
+  EXPECT_EQ(integrals.SnapToGrid({2, 1, 38, 19}, bounds), cv::Rect(1, 3, 40, 16));
+  // Clamped to the bounds: local 0 (global 3) would go to global 4 but 49 -> global 52 -> 49.
+  EXPECT_EQ(integrals.SnapToGrid({0, 0, 49, 30}, {0, 0, 49, 30}), cv::Rect(1, 0, 48, 30));
+}
+
+// --- Extractor: shared colour, snapping, wide maps ----------------------------------------------
+
+// Smooth random colours (like a real frame at small scale) and a boundary-like edge map.
+void SmoothScene(int rows, int cols, cv::Mat3b& image, cv::Mat1f& map) {
+  cv::Mat3b coarse = RandomColours(rows / 12 + 2, cols / 12 + 2, 5);
+  cv::resize(coarse, image, {cols, rows}, 0, 0, cv::INTER_LINEAR);
+  map = cv::Mat1f(rows, cols, 0.f);
+  cv::RNG rng(6);
+  for (int x = 5; x < cols; x += 13) {
+    for (int y = 0; y < rows; ++y) map(y, x) = 0.1f * static_cast<float>(1 + (y / 9) % 4);
+  }
+  for (int y = 3; y < rows; y += 11) {
+    for (int x = 0; x < cols; ++x) map(y, x) = 0.25f;
+  }
+}
+
+std::vector<ScoredBox> RandomBoxes(int count, cv::Rect area, int min_side, int max_side,
+                                   std::uint64_t seed) {
+  cv::RNG rng(seed);
+  std::vector<ScoredBox> boxes;
+  for (int i = 0; i < count; ++i) {
+    const int w = rng.uniform(min_side, max_side + 1), h = rng.uniform(min_side, max_side + 1);
+    // Some boxes stick out of the area to exercise clipping.
+    boxes.push_back({{area.x + rng.uniform(-w / 2, area.width - w / 2),
+                      area.y + rng.uniform(-h / 2, area.height - h / 2), w, h},
+                     rng.uniform(0.f, 1.f)});
+  }
+  return boxes;
+}
+
+TEST(BoxFeaturesTest, SharedColourGivesTheSameFeaturesAsPerRegionColour) {
+  // Frame 120 x 90; R1 = [7, 127) x [9, 99) of a 140 x 110 image; the region is a nested crop at
+  // full-image (22, 17), size 70 x 50, with an edge map of its own.
+  cv::Mat3b frame;
+  cv::Mat1f frame_map;
+  SmoothScene(110, 140, frame, frame_map);
+  const cv::Rect r1(7, 9, 120, 90);
+  const cv::Rect region(22, 17, 70, 50);
+  const cv::Size image_size = frame.size();
+  auto colour = std::make_shared<const ColourIntegrals>(frame(r1), r1.tl());
+  const cv::Mat1f region_map = frame_map(region).clone();
+  for (const bool exact : {true, false}) {
+    // Snap from small grown boxes on so that the snapping path is exercised too.
+    const BoxFeatureOptions options{.exact_contrast = exact, .contrast_snap_min_area = 0};
+    const BoxFeatureExtractor per_region(region_map, frame(region), region.tl(), image_size,
+                                         options);
+    const BoxFeatureExtractor shared(colour, region_map, region.tl(), image_size, options);
+    ASSERT_TRUE(shared.status().ok()) << shared.status().message();
+    for (const ScoredBox& b : RandomBoxes(300, region, 1, 60, 8)) {
+      const BoxFeatureVector a = per_region.Compute(b.box, b.score);
+      const BoxFeatureVector c = shared.Compute(b.box, b.score);
+      for (int i = 0; i < kNumBoxFeatures; ++i) {
+        if (i >= 14 && i <= 16) {  // sums over differently placed cells: rounding only
+          ASSERT_NEAR(a[i], c[i], 1e-6) << "feature " << i << " exact " << exact;
+        } else {
+          ASSERT_EQ(a[i], c[i]) << "feature " << i << " exact " << exact << " box " << b.box.x
+                                << "," << b.box.y << " " << b.box.w << "x" << b.box.h;
+        }
+      }
+    }
+  }
+}
+
+TEST(BoxFeaturesTest, SnappedContrastIsCloseToExactOnLargeBoxes) {
+  cv::Mat3b image;
+  cv::Mat1f map;
+  SmoothScene(240, 320, image, map);
+  const BoxFeatureExtractor fast(map, image, {0, 0}, image.size());  // default: snap >= 128^2
+  const BoxFeatureExtractor exact(map, image, {0, 0}, image.size(), {.exact_contrast = true});
+  double largest_change = 0.0;
+  for (const ScoredBox& b : RandomBoxes(200, {0, 0, 320, 240}, 64, 110, 9)) {
+    const BoxFeatureVector f = fast.Compute(b.box, b.score);
+    const BoxFeatureVector e = exact.Compute(b.box, b.score);
+    for (int i = 0; i < 17; ++i) ASSERT_EQ(f[i], e[i]) << "feature " << i;  // not approximated
+    for (int i = 17; i < 20; ++i) {
+      ASSERT_NEAR(f[i], e[i], 0.03) << "feature " << i;
+      largest_change = std::max(largest_change, std::abs(static_cast<double>(f[i]) - e[i]));
+    }
+  }
+  EXPECT_GT(largest_change, 0.0);  // the snapped path did run
+  // Small boxes are never snapped.
+  for (const ScoredBox& b : RandomBoxes(200, {0, 0, 320, 240}, 2, 40, 10)) {
+    EXPECT_EQ(fast.Compute(b.box, b.score), exact.Compute(b.box, b.score));
+  }
+}
+
+// Brute-force features 1-7 of a local box (M may be negative: sums include it, counts do not).
+std::array<double, 7> DenseEdgeFeatures7(const cv::Mat1f& map, const cv::Rect& r) {
+  const cv::Rect inner(r.x + (r.width - r.width / 2) / 2, r.y + (r.height - r.height / 2) / 2,
+                       r.width / 2, r.height / 2);
+  std::vector<float> values;
+  double sum = 0.0, inner_sum = 0.0, inner_count = 0.0;
+  for (int y = r.y; y < r.y + r.height; ++y) {
+    for (int x = r.x; x < r.x + r.width; ++x) {
+      sum += map(y, x);
+      if (map(y, x) > 0.f) values.push_back(map(y, x));
+      if (inner.contains({x, y})) {
+        inner_sum += map(y, x);
+        inner_count += map(y, x) > 0.f;
+      }
+    }
+  }
+  const double area = r.area();
+  std::array<double, 7> out = {
+      0, 0, 0, inner_sum / (area / 4), inner_count / (area / 4), sum / area, values.size() / area};
+  if (values.empty()) return out;
+  std::sort(values.begin(), values.end());
+  long best = 0;
+  for (float v : values) {
+    const long n = std::count(values.begin(), values.end(), v);
+    if (n > best) best = n, out[1] = v;
+  }
+  out[0] = values.back();
+  out[2] = static_cast<double>(best) / values.size();
+  return out;
+}
+
+TEST(BoxFeaturesTest, EdgeFeaturesAcrossColumnBandsMatchDenseReference) {
+  // 150 columns = three 64-column bands (the last partial); boxes up to 120 wide straddle them.
+  cv::RNG rng(321);
+  cv::Mat1f map(40, 150);
+  const float levels[] = {0.f, 0.f, 0.f, 0.f, 0.1f, 0.2f, 0.3f, -0.2f};
+  for (int y = 0; y < map.rows; ++y) {
+    for (int x = 0; x < map.cols; ++x) map(y, x) = levels[rng.uniform(0, 8)];
+  }
+  const BoxFeatureExtractor extractor(map, Uniform(40, 150, {0, 0, 0}), {0, 0}, {150, 40});
+  for (int trial = 0; trial < 300; ++trial) {
+    const int w = rng.uniform(1, 121), h = rng.uniform(1, 41);
+    const cv::Rect r(rng.uniform(0, 151 - w), rng.uniform(0, 41 - h), w, h);
+    const BoxFeatureVector f = extractor.Compute(Box::FromRect(r), 0.f);
+    const std::array<double, 7> expected = DenseEdgeFeatures7(map, r);
+    for (int i = 0; i < 7; ++i) ASSERT_NEAR(f[i], expected[i], kTol) << "feature " << i;
+  }
+}
+
+TEST(BoxFeaturesTest, InvalidSharedInputIsAnError) {
+  const cv::Mat3b frame = Uniform(40, 60, {0, 0, 0});
+  auto colour = std::make_shared<const ColourIntegrals>(frame, cv::Point(10, 10));
+  auto no_colour = BoxFeatureExtractor::Create(nullptr, cv::Mat1f(8, 8, 0.f), {10, 10}, {100, 80});
+  ASSERT_FALSE(no_colour.ok());
+  EXPECT_NE(no_colour.status().message().find("frame_colour"), std::string::npos);
+  // Region [65, 75) x [10, 18) is in the frame but not in the colour crop [10, 70) x [10, 50).
+  auto outside = BoxFeatureExtractor::Create(colour, cv::Mat1f(8, 10, 0.f), {65, 10}, {100, 80});
+  ASSERT_FALSE(outside.ok());
+  EXPECT_NE(outside.status().message().find("frame_colour crop"), std::string::npos);
+  auto good = BoxFeatureExtractor::Create(colour, cv::Mat1f(8, 10, 0.f), {60, 42}, {100, 80});
+  EXPECT_TRUE(good.ok()) << good.status().message();
 }
 
 }  // namespace
