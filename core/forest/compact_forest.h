@@ -13,6 +13,7 @@
 // RandomForest::Predict does, so the results are bit-identical.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -33,6 +34,8 @@ class CompactForest {
                              const std::vector<std::int32_t>& roots, int num_features);
 
   bool empty() const { return roots_.empty(); }
+  // Bytes a prediction may touch per node: the packed node and its leaf value.
+  static constexpr std::size_t bytes_per_node() { return sizeof(PackedNode) + sizeof(float); }
 
   // For every tree in order, adds the value of the leaf that rows[k] reaches to sums[k], for
   // k in [0, count). Each row must hold at least num_features values.
@@ -43,6 +46,7 @@ class CompactForest {
     float threshold = 0.f;   // go to the right child when x > threshold; +inf in a leaf
     std::uint32_t word = 0;  // (left child index << feature_bits_) | feature; leaf: own index
   };
+  static_assert(sizeof(PackedNode) == 8);
 
   int feature_bits_ = 0;
   std::uint32_t feature_mask_ = 0;

@@ -17,9 +17,9 @@ namespace {
 constexpr int kMaxTrees = 1 << 20;
 constexpr long long kMaxRows = 1 << 30;
 constexpr long long kMaxNodes = std::numeric_limits<std::int32_t>::max() - 1;
-// Rows per block of tree-major prediction (see BlockRows).
+// Rows per block of tree-major prediction (see PredictionBlockRows).
 constexpr int kMinBlockRows = 1024;
-constexpr double kBlockRowBytesPerTreeByte = 16.0;
+constexpr double kBlockRowBytesPerTreeByte = 24.0;
 
 Status ValidateTrainingInput(const cv::Mat1f& features, const std::vector<float>& targets,
                              const ForestParams& params) {
@@ -168,16 +168,18 @@ void RandomForest::PackForPrediction() {
   compact_ = CompactForest::Build(nodes_, tree_roots_, num_features_);
 }
 
-int RandomForest::BlockRows() const {
+int RandomForest::PredictionBlockRows() const {
   // A block walks one tree for all its rows, then the next tree. Loading a tree into cache costs
-  // random misses, streaming the block's rows through again costs (prefetched) sequential reads,
-  // so the block's row bytes are made a multiple of the tree's bytes: big trees (the 200-tree
-  // proposal regressors, ~190 KiB per tree) get blocks of tens of thousands of rows, small ones
-  // (the 8-tree pixel forest, ~50 KiB) a few thousand, which keeps those rows in L2 across trees.
-  // Measured in tests/bench/bench_forest_predict.cc.
-  const double tree_bytes = static_cast<double>(nodes_.size()) * (sizeof(Node) + sizeof(float)) /
+  // random misses; streaming the block's rows through once more costs prefetched sequential
+  // reads. So the block's row bytes are made a multiple of a tree's bytes: big trees (the
+  // 200-tree proposal regressors, ~190 KiB packed per tree) get blocks of ~45 000 rows, small
+  // ones (the 8-tree pixel forest, ~50 KiB) ~6 000, which keeps those rows in L2 across trees.
+  // The factor was tuned with tests/bench/bench_forest_predict.cc.
+  const double node_bytes = compact_.empty() ? sizeof(Node) : compact_.bytes_per_node();
+  const double tree_bytes = static_cast<double>(nodes_.size()) * node_bytes /
                             static_cast<double>(std::max<std::size_t>(1, tree_roots_.size()));
-  const double row_bytes = static_cast<double>(num_features_) * sizeof(float) + 2 * sizeof(double);
+  const double row_bytes = static_cast<double>(num_features_) * sizeof(float) +
+                           sizeof(const float*) + sizeof(double);  // row, its pointer and sum
   const double rows = kBlockRowBytesPerTreeByte * tree_bytes / row_bytes;
   return static_cast<int>(std::clamp(rows, static_cast<double>(kMinBlockRows), 1e9));
 }
@@ -185,16 +187,16 @@ int RandomForest::BlockRows() const {
 void RandomForest::PredictRows(const float* const* rows, int count, float* out) const {
   // Blocks of rows walk one tree after another so a tree stays in cache across the block.
   // Per row the sum runs over trees in the same order as Predict: results are identical.
-  const int block_rows = BlockRows();
-  std::vector<double> sums(static_cast<std::size_t>(std::min(count, block_rows)));
+  const int rows_per_block = PredictionBlockRows();
+  std::vector<double> sums(static_cast<std::size_t>(std::min(count, rows_per_block)));
   const auto trees = static_cast<double>(tree_roots_.size());
-  for (int start = 0; start < count; start += block_rows) {
-    const int block = std::min(count - start, block_rows);
+  for (int start = 0; start < count; start += rows_per_block) {
+    const int block = std::min(count - start, rows_per_block);
     const float* const* block_rows = rows + start;
     std::fill(sums.begin(), sums.end(), 0.0);
     if (!compact_.empty()) {
       compact_.AccumulateLeafValues(block_rows, block, sums.data());
-    } else {
+    } else {  // too many nodes to pack: walk the stored nodes (same order, same sums)
       for (const std::int32_t root : tree_roots_) {
         for (int r = 0; r < block; ++r) {
           std::int32_t i = root;

@@ -55,6 +55,9 @@ class RandomForest {
   bool empty() const { return tree_roots_.empty(); }
   // Total node count over all trees (split nodes + leaves).
   std::int64_t num_nodes() const { return static_cast<std::int64_t>(nodes_.size()); }
+  // How many rows PredictBatch walks through one tree before going on to the next (depends on
+  // the trees' size; for diagnostics and tests).
+  int PredictionBlockRows() const;
   // Number of leaves of one tree (for tests and diagnostics); 0 for an index out of range.
   int CountLeaves(int tree) const;
 
@@ -70,8 +73,6 @@ class RandomForest {
   // Sums the trees' outputs for `count` rows (tree order per row, as Predict) and writes the
   // means to out[0, count).
   void PredictRows(const float* const* rows, int count, float* out) const;
-  // How many rows PredictRows walks through one tree before moving to the next.
-  int BlockRows() const;
   // Rebuilds compact_ from nodes_ and tree_roots_; called whenever those change.
   void PackForPrediction();
 

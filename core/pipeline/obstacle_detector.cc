@@ -33,9 +33,7 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   // OBDR only matters for the boxes that pass the fusion gate (top keep_ratio by ORDR, §6.5), so
   // only those are scored; the rest keep OBDR 0.
   const std::vector<int> gated = GatedByOrdr(out.ordr, bundle.params.fusion);
-  cv::Mat1f gated_rows(static_cast<int>(gated.size()), features.cols);
-  for (std::size_t r = 0; r < gated.size(); ++r) features.row(gated[r]).copyTo(gated_rows.row(static_cast<int>(r)));
-  const std::vector<float> gated_obdr = bundle.obdr.PredictBatch(gated_rows);
+  const std::vector<float> gated_obdr = bundle.obdr.PredictBatch(features, gated);
   out.obdr.assign(out.ordr.size(), 0.f);
   for (std::size_t r = 0; r < gated.size() && r < gated_obdr.size(); ++r) out.obdr[gated[r]] = gated_obdr[r];
   if (timer) timer->Mark("regression");

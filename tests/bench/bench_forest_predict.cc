@@ -128,10 +128,11 @@ void Run(const Case& c, int repeats, const std::string& cache_dir) {
   const double batch = Median(batch_ms);
   const double per_row = 1000.0 / test.x.rows;  // ms -> us per row
   std::printf(
-      "| %s | %d | %lld | %d | %.1f (%.2f us/row) | %.1f (%.2f us/row) | %.1fx | %.1f | %s |\n",
-      c.name.c_str(), forest.num_trees(), static_cast<long long>(forest.num_nodes()), test.x.rows,
-      loop, loop * per_row, batch, batch * per_row, loop / batch, Median(subset_ms),
-      identical ? "yes" : "NO");
+      "| %s | %d | %lld | %d | %d | %.1f (%.2f us/row) | %.1f (%.2f us/row) | %.1fx | %.1f | %s "
+      "|\n",
+      c.name.c_str(), forest.num_trees(), static_cast<long long>(forest.num_nodes()),
+      forest.PredictionBlockRows(), test.x.rows, loop, loop * per_row, batch, batch * per_row,
+      loop / batch, Median(subset_ms), identical ? "yes" : "NO");
 }
 
 }  // namespace
@@ -149,9 +150,10 @@ int main(int argc, char** argv) {
   std::printf("RandomForest prediction on one thread, medians of %d runs (thread CPU time)\n\n",
               repeats);
   std::printf(
-      "| forest | trees | nodes | rows | Predict loop ms | PredictBatch ms | speed-up | "
+      "| forest | trees | nodes | block rows | rows | Predict loop ms | PredictBatch ms | speed-up "
+      "| "
       "PredictBatch on every 2nd row ms | bit-identical |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   Run(proposals, repeats, cache_dir);
   Run(pixels, repeats, cache_dir);
   return 0;

@@ -166,10 +166,14 @@ RandomForest DeepForest() {
 TEST(BatchPrediction, ManyBlocksMatchPredictBitForBit) {
   const RandomForest forest = DeepForest();
   ASSERT_EQ(forest.num_trees(), 12);
-  // 5003 rows: several blocks of at least 1024 rows and a partial lock-step group at the end.
-  const Data test = MakeData(5003, 3, 32);
+  // Over two blocks' worth of rows, and a partial lock-step group (of 8) at the end.
+  const int block = forest.PredictionBlockRows();
+  ASSERT_GE(block, 1024);
+  ASSERT_LE(block, 20000) << "this small forest should get small blocks";
+  const int rows = 2 * block + 1003;
+  const Data test = MakeData(rows, 3, 32);
   const std::vector<float> batch = forest.PredictBatch(test.x);
-  ASSERT_EQ(batch.size(), 5003u);
+  ASSERT_EQ(batch.size(), static_cast<std::size_t>(rows));
   int mismatches = 0;
   for (int r = 0; r < test.x.rows; ++r) mismatches += batch[r] != forest.Predict(test.x[r]);
   EXPECT_EQ(mismatches, 0);
