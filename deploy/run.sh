@@ -19,6 +19,6 @@ frame=$(find out/demo/data/leftImg8bit/test -name '*.png' | sort | head -n 1)
 "$BIN/tod" detect --model "$MODEL" --out out/demo "$frame"
 echo "overlay: out/demo/$(basename "${frame%.png}")_overlay.png"
 
-echo "starting tod_server on $MODEL (gRPC :${TOD_GRPC_PORT:-50051}, HTTP :${TOD_HTTP_PORT:-8080}); Ctrl-C drains and stops"
-exec "$BIN/tod_server" --model "$MODEL" --grpc-port "${TOD_GRPC_PORT:-50051}" \
-  --http-port "${TOD_HTTP_PORT:-8080}"
+echo "starting tod_server on $MODEL (gRPC :${TOD_GRPC_PORT:-8001}, HTTP :${TOD_HTTP_PORT:-8000}); Ctrl-C drains and stops"
+exec "$BIN/tod_server" --model "$MODEL" --grpc-port "${TOD_GRPC_PORT:-8001}" \
+  --http-port "${TOD_HTTP_PORT:-8000}"

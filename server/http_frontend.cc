@@ -7,6 +7,7 @@
 #include <charconv>
 #include <chrono>
 #include <future>
+#include <thread>
 
 #include "server/detect_response.h"
 #include "server/logging.h"
@@ -154,11 +155,20 @@ Status HttpFrontend::Bind(const std::string& host, int port) {
 }
 
 void HttpFrontend::Start() {
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  listener_done_ = false;
+  thread_ = std::thread([this] {
+    server_->listen_after_bind();
+    listener_done_ = true;
+  });
 }
 
 void HttpFrontend::Stop() {
   if (!thread_.joinable()) return;
+  // httplib's stop() does nothing until the listen loop runs: wait for it (or for its failure),
+  // otherwise a Stop() right after Start() would leave the loop running and the join hanging.
+  while (!server_->is_running() && !listener_done_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
   server_->stop();
   thread_.join();
 }
@@ -248,6 +258,7 @@ void HttpFrontend::HandleDetect(const httplib::Request& request, httplib::Respon
     FillDetectResponse(result, frame_id, &message);
     response.set_content(MessageToJson(message), kJson);
   }
+  response.status = 200;
   finish_log(code, "");
 }
 

@@ -59,6 +59,7 @@ class HttpFrontend {
   ServerMetrics& metrics_;
   std::unique_ptr<httplib::Server> server_;
   std::thread thread_;
+  std::atomic<bool> listener_done_{false};  // listen_after_bind() has returned
   int port_ = 0;
   std::atomic<uint64_t> request_counter_{0};
 };

@@ -48,13 +48,16 @@ void LogEvent(spdlog::level::level_enum level, std::string_view message,
   if (!spdlog::should_log(level)) return;
   std::string line;
   if (json_format) {
-    line = "\"msg\":" + Dump(nlohmann::json(std::string(message)));
+    // Appends piece by piece (also sidesteps GCC 12's false -Wrestrict on "literal" + string).
+    line.append("\"msg\":").append(Dump(nlohmann::json(std::string(message))));
     for (const auto& [key, value] : fields.items()) {
-      line += "," + Dump(nlohmann::json(key)) + ":" + Dump(value);
+      line.append(",").append(Dump(nlohmann::json(key))).append(":").append(Dump(value));
     }
   } else {
     line = std::string(message);
-    for (const auto& [key, value] : fields.items()) line += " " + key + "=" + TextValue(value);
+    for (const auto& [key, value] : fields.items()) {
+      line.append(" ").append(key).append("=").append(TextValue(value));
+    }
   }
   spdlog::log(level, "{}", line);
 }

@@ -86,6 +86,9 @@ int RunServer(const ServerConfig& config) {
     return 1;
   }
   grpc::HealthCheckServiceInterface* health = grpc_server->GetHealthCheckService();
+  // Register the service's own name too (grpc.health.v1 answers NOT_FOUND for unknown names);
+  // SetServingStatus(bool) below then switches "" and this name together.
+  health->SetServingStatus(tod::v1::ObstacleDiscovery::service_full_name(), false);
   health->SetServingStatus(false);
 
   HttpFrontendConfig http_config;

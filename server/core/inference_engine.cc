@@ -246,6 +246,11 @@ bool InferenceEngine::draining() const {
   return draining_ || stopping_;
 }
 
+size_t InferenceEngine::queue_depth() const {
+  std::lock_guard lock(mutex_);
+  return queue_.size();
+}
+
 bool InferenceEngine::WaitIdle(Clock::time_point deadline) {
   std::unique_lock lock(mutex_);
   return idle_.wait_until(lock, deadline, [this] { return queue_.empty() && running_ == 0; });

@@ -1,0 +1,106 @@
+// Configuration precedence (file < environment < flags) and validation messages.
+#include "server/config.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+namespace tod::server {
+namespace {
+
+EnvLookup FakeEnv(std::map<std::string, std::string> values) {
+  auto shared = std::make_shared<std::map<std::string, std::string>>(std::move(values));
+  return [shared](const char* name) -> const char* {
+    const auto it = shared->find(name);
+    return it == shared->end() ? nullptr : it->second.c_str();
+  };
+}
+
+std::string WriteTempFile(const std::string& name, const std::string& text) {
+  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(ConfigTest, DefaultsNeedOnlyAModel) {
+  const Result<ServerConfig> config = ResolveServerConfig({{"model", "/m"}}, FakeEnv({}));
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config->model_dir, "/m");
+  EXPECT_EQ(config->grpc_port, 8001);
+  EXPECT_EQ(config->http_port, 8000);
+  EXPECT_GE(config->workers, 1);  // 0 resolved to the core count
+  EXPECT_EQ(config->queue, 64);
+}
+
+TEST(ConfigTest, FlagsBeatEnvironmentBeatsFile) {
+  const std::string file =
+      WriteTempFile("tod_config_test.json",
+                    R"({"model": "/from/file", "grpc_port": 9001, "http_port": 9000, "queue": 3,
+          "log_format": "json"})");
+  const Result<ServerConfig> config = ResolveServerConfig(
+      {{"config", file}, {"grpc_port", "7001"}},
+      FakeEnv({{"TOD_GRPC_PORT", "8101"}, {"TOD_HTTP_PORT", "8100"}, {"TOD_WORKERS", "3"}}));
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config->model_dir, "/from/file");  // file only
+  EXPECT_EQ(config->queue, 3);                 // file only
+  EXPECT_EQ(config->log_format, "json");       // file only
+  EXPECT_EQ(config->http_port, 8100);          // env beats file
+  EXPECT_EQ(config->workers, 3);               // env only
+  EXPECT_EQ(config->grpc_port, 7001);          // flag beats env and file
+  std::remove(file.c_str());
+}
+
+TEST(ConfigTest, ConfigFileFromEnvironment) {
+  const std::string file = WriteTempFile("tod_config_env.json", R"({"model": "/env/file"})");
+  const Result<ServerConfig> config = ResolveServerConfig({}, FakeEnv({{"TOD_CONFIG", file}}));
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config->model_dir, "/env/file");
+  std::remove(file.c_str());
+}
+
+TEST(ConfigTest, ErrorsNameTheSourceAndTheSetting) {
+  const Status no_model = ResolveServerConfig({}, FakeEnv({})).status();
+  EXPECT_NE(no_model.message().find("--model"), std::string::npos) << no_model.message();
+
+  const Status bad_env =
+      ResolveServerConfig({{"model", "/m"}}, FakeEnv({{"TOD_QUEUE", "many"}})).status();
+  EXPECT_NE(bad_env.message().find("TOD_QUEUE"), std::string::npos) << bad_env.message();
+
+  const std::string file = WriteTempFile("tod_config_bad.json", R"({"modle": "/x"})");
+  const Status unknown = ResolveServerConfig({{"config", file}}, FakeEnv({})).status();
+  EXPECT_NE(unknown.message().find(file), std::string::npos) << unknown.message();
+  EXPECT_NE(unknown.message().find("modle"), std::string::npos) << unknown.message();
+  std::remove(file.c_str());
+
+  const std::string broken = WriteTempFile("tod_config_broken.json", "{not json");
+  const Status invalid = ResolveServerConfig({{"config", broken}}, FakeEnv({})).status();
+  EXPECT_NE(invalid.message().find("invalid JSON"), std::string::npos) << invalid.message();
+  std::remove(broken.c_str());
+
+  EXPECT_FALSE(ResolveServerConfig({{"config", "/no/such/file.json"}}, FakeEnv({})).ok());
+  EXPECT_FALSE(ResolveServerConfig({{"model", "/m"}, {"grpc_port", "70000"}}, FakeEnv({})).ok());
+  EXPECT_FALSE(
+      ResolveServerConfig({{"model", "/m"}, {"grpc_port", "9"}, {"http_port", "9"}}, FakeEnv({}))
+          .ok());
+  EXPECT_FALSE(ResolveServerConfig({{"model", "/m"}, {"log_format", "xml"}}, FakeEnv({})).ok());
+  EXPECT_FALSE(
+      ResolveServerConfig({{"model", "/m"}, {"max_image_pixels", "1000000000"}}, FakeEnv({})).ok());
+}
+
+TEST(ConfigTest, EverySettingHasAFlagAnEnvironmentVariableAndAJsonKey) {
+  for (const SettingSpec& spec : SettingSpecs()) {
+    EXPECT_EQ(spec.env.rfind("TOD_", 0), 0u) << spec.key;
+    ServerConfig config;
+    // Each key is accepted by the one parser (a number where a number is expected).
+    const bool numeric = spec.key != "model" && spec.key != "host" && spec.key != "log_format" &&
+                         spec.key != "log_level";
+    EXPECT_TRUE(ApplySetting(spec.key, numeric ? "5" : "text", "test", &config).ok()) << spec.key;
+    EXPECT_TRUE(ServerConfigToJson(config).contains(spec.key)) << spec.key;
+  }
+}
+
+}  // namespace
+}  // namespace tod::server

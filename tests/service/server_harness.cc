@@ -1,0 +1,179 @@
+#include "tests/service/server_harness.h"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <httplib.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "tests/test_env.h"
+
+extern char** environ;
+
+namespace tod::server::testing {
+namespace {
+
+// Spawns argv with stdout+stderr into `log_path`; returns the pid or -1.
+pid_t Spawn(const std::vector<std::string>& argv, const std::string& log_path) {
+  std::vector<char*> args;
+  for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+  args.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  // The server blocks its signals itself; start it with a clean mask and default handlers.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attributes, &none);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, args[0], &actions, &attributes, args.data(), environ) != 0) pid = -1;
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
+  return pid;
+}
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+int DecodeWaitStatus(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
+
+}  // namespace
+
+int FreeLoopbackPort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = 0;
+  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address));
+  socklen_t length = sizeof(address);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
+  close(fd);
+  return ntohs(address.sin_port);
+}
+
+std::string BinaryPath(const std::string& name) { return tod::testing_env::BinDir() + "/" + name; }
+
+std::string MakeTempDir(const std::string& prefix) {
+  static std::mt19937_64 random(std::random_device{}());
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      (prefix + "_" + std::to_string(getpid()) + "_" + std::to_string(random() % 1000000007));
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+ProcessResult RunCommand(const std::vector<std::string>& argv) {
+  const std::string log = MakeTempDir("tod_cmd") + "/output.txt";
+  ProcessResult result;
+  const pid_t pid = Spawn(argv, log);
+  if (pid < 0) {
+    result.output = "cannot start " + argv[0];
+    return result;
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  result.exit_code = DecodeWaitStatus(status);
+  result.output = ReadAll(log);
+  return result;
+}
+
+std::unique_ptr<ServerProcess> ServerProcess::Start(const std::string& model_dir,
+                                                    const std::vector<std::string>& extra_args) {
+  std::unique_ptr<ServerProcess> server(new ServerProcess());
+  server->grpc_port_ = FreeLoopbackPort();
+  do {
+    server->http_port_ = FreeLoopbackPort();
+  } while (server->http_port_ == server->grpc_port_);
+  server->log_path_ = MakeTempDir("tod_server") + "/server.log";
+  std::vector<std::string> argv = {BinaryPath("tod_server"),
+                                   "--model",
+                                   model_dir,
+                                   "--host",
+                                   "127.0.0.1",
+                                   "--grpc-port",
+                                   std::to_string(server->grpc_port_),
+                                   "--http-port",
+                                   std::to_string(server->http_port_)};
+  argv.insert(argv.end(), extra_args.begin(), extra_args.end());
+  server->pid_ = Spawn(argv, server->log_path_);
+  return server;
+}
+
+ServerProcess::~ServerProcess() {
+  if (pid_ > 0 && !exit_code_) {
+    kill(pid_, SIGKILL);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+  }
+}
+
+bool ServerProcess::WaitReady(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  httplib::Client client("127.0.0.1", http_port_);
+  client.set_connection_timeout(std::chrono::milliseconds(200));
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (WaitExit(std::chrono::milliseconds(0))) return false;
+    if (const auto response = client.Get("/v2/health/ready"); response && response->status == 200) {
+      return true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
+void ServerProcess::Signal(int signal_number) const {
+  if (pid_ > 0 && !exit_code_) kill(pid_, signal_number);
+}
+
+std::optional<int> ServerProcess::WaitExit(std::chrono::milliseconds timeout) {
+  if (exit_code_ || pid_ <= 0) return exit_code_;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      exit_code_ = DecodeWaitStatus(status);
+      return exit_code_;
+    }
+    if (std::chrono::steady_clock::now() >= deadline) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+std::string ServerProcess::Log() const { return ReadAll(log_path_); }
+
+std::string ScrapeMetrics(int http_port) {
+  httplib::Client client("127.0.0.1", http_port);
+  const auto response = client.Get("/metrics");
+  return response && response->status == 200 ? response->body : "";
+}
+
+std::optional<double> MetricValue(const std::string& metrics_text, const std::string& series) {
+  std::istringstream lines(metrics_text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind(series + " ", 0) == 0) return std::stod(line.substr(series.size() + 1));
+  }
+  return std::nullopt;
+}
+
+}  // namespace tod::server::testing

@@ -1,0 +1,65 @@
+// Runs the real tod_server binary for end-to-end tests: free loopback ports, a log file, signals,
+// readiness polling, and helpers to read the Prometheus text.
+#pragma once
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace tod::server::testing {
+
+// A TCP port on 127.0.0.1 that was free a moment ago.
+int FreeLoopbackPort();
+
+// <bin dir>/<name> (tests/test_env.h: configured, or $TOD_BIN_DIR).
+std::string BinaryPath(const std::string& name);
+
+// A fresh empty directory under the system temp directory.
+std::string MakeTempDir(const std::string& prefix);
+
+struct ProcessResult {
+  int exit_code = -1;  // -1: killed by a signal or still running
+  std::string output;  // stdout + stderr
+};
+
+// Runs a command to completion (stdout+stderr captured); for tod_client / tod_load.
+ProcessResult RunCommand(const std::vector<std::string>& argv);
+
+class ServerProcess {
+ public:
+  // Starts tod_server --model DIR on two free loopback ports plus `extra_args`.
+  static std::unique_ptr<ServerProcess> Start(const std::string& model_dir,
+                                              const std::vector<std::string>& extra_args);
+  ~ServerProcess();  // SIGKILL if still running
+
+  // Polls GET /v2/health/ready until 200; false if the process exits or `timeout` passes.
+  bool WaitReady(std::chrono::milliseconds timeout = std::chrono::seconds(60));
+  void Signal(int signal_number) const;
+  // Exit code once the process ends (within `timeout`), else nullopt.
+  std::optional<int> WaitExit(std::chrono::milliseconds timeout);
+  std::string Log() const;
+
+  int grpc_port() const { return grpc_port_; }
+  int http_port() const { return http_port_; }
+  std::string grpc_address() const { return "127.0.0.1:" + std::to_string(grpc_port_); }
+
+ private:
+  ServerProcess() = default;
+  pid_t pid_ = -1;
+  int grpc_port_ = 0;
+  int http_port_ = 0;
+  std::string log_path_;
+  std::optional<int> exit_code_;
+};
+
+// GET /metrics from the server as text ("" on failure).
+std::string ScrapeMetrics(int http_port);
+// Value of the first sample whose line starts with `series` (name + labels as printed),
+// e.g. `tod_rejections_total{reason="deadline"}`; nullopt when absent.
+std::optional<double> MetricValue(const std::string& metrics_text, const std::string& series);
+
+}  // namespace tod::server::testing

@@ -1,0 +1,331 @@
+// End-to-end: the real tod_server with the real pipeline (the tiny bundle of the CTest fixture,
+// $TOD_TEST_MODEL) on loopback ports, driven through the real client library, tod_client,
+// tod_load and plain HTTP.
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <thread>
+
+#include "client/tod_grpc_client.h"
+#include "tests/service/server_harness.h"
+#include "tests/service/test_images.h"
+#include "tests/test_env.h"
+
+namespace tod::server {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using testing::MetricValue;
+using testing::RunCommand;
+using testing::ScrapeMetrics;
+using testing::ServerProcess;
+
+// Limits the shared server runs with; the error tests go just over them.
+constexpr int kMaxBytes = 400'000;
+constexpr int kMaxPixels = 700 * 400;
+
+std::string TestModel() {
+  const std::string model = tod::testing_env::TestModel();
+  return fs::exists(fs::path(model) / "manifest.json") ? model : "";
+}
+
+#define REQUIRE_MODEL()                                                             \
+  if (TestModel().empty() || !fs::exists(testing::BinaryPath("tod_server"))) {      \
+    GTEST_SKIP() << "no test model bundle or tod_server (run through ctest, which " \
+                    "provides the tiny_model fixture)";                             \
+  }
+
+tod::v1::DetectRequest MakeRequest(const std::string& image, const std::string& frame_id = "") {
+  tod::v1::DetectRequest request;
+  request.set_image(image);
+  request.set_frame_id(frame_id);
+  return request;
+}
+
+httplib::Result PostImage(httplib::Client& client, const std::string& path, const std::string& body,
+                          const std::string& type = "image/png") {
+  return client.Post(path.c_str(), body, type.c_str());
+}
+
+std::string ErrorMessage(const httplib::Result& result) {
+  if (!result) return "";
+  const nlohmann::json json = nlohmann::json::parse(result->body, nullptr, false);
+  return json.is_discarded() ? "" : json["error"].value("message", "");
+}
+
+// One server shared by the functional tests of this suite.
+class ServiceE2ETest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (TestModel().empty() || !fs::exists(testing::BinaryPath("tod_server"))) return;
+    server_ =
+        ServerProcess::Start(TestModel(), {"--workers", "2", "--queue", "16", "--max-image-bytes",
+                                           std::to_string(kMaxBytes), "--max-image-pixels",
+                                           std::to_string(kMaxPixels), "--log-format", "json"})
+            .release();
+    ready_ = server_->WaitReady();
+  }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+  void SetUp() override {
+    REQUIRE_MODEL();
+    ASSERT_TRUE(ready_) << server_->Log();
+    http_ = std::make_unique<httplib::Client>("127.0.0.1", server_->http_port());
+    http_->set_read_timeout(60s);
+    grpc_ = std::make_unique<client::TodGrpcClient>(server_->grpc_address());
+  }
+  void ExpectStillServes() {
+    tod::v1::DetectResponse response;
+    const grpc::Status status = grpc_->Detect(MakeRequest(testing::RoadPng()), &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    const auto live = http_->Get("/v2/health/ready");
+    ASSERT_TRUE(live);
+    EXPECT_EQ(live->status, 200);
+  }
+
+  static inline ServerProcess* server_ = nullptr;
+  static inline bool ready_ = false;
+  std::unique_ptr<httplib::Client> http_;
+  std::unique_ptr<client::TodGrpcClient> grpc_;
+};
+
+TEST_F(ServiceE2ETest, GrpcAndRestAgreeOnASyntheticFrame) {
+  const std::string frame = testing::RoadPng();
+  tod::v1::DetectResponse grpc_response;
+  const grpc::Status status = grpc_->Detect(MakeRequest(frame, "f1"), &grpc_response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(grpc_response.frame_id(), "f1");
+  EXPECT_EQ(grpc_response.width(), 320);
+  EXPECT_EQ(grpc_response.height(), 160);
+  EXPECT_FALSE(grpc_response.model_version().empty());
+  EXPECT_EQ(grpc_response.probability_map().width(), 320);
+  ASSERT_FALSE(grpc_response.probability_map().png().empty());
+  ASSERT_GE(grpc_response.timings_size(), 3);
+  EXPECT_EQ(grpc_response.timings(0).stage(), "queue");
+  EXPECT_EQ(grpc_response.timings(1).stage(), "decode");
+  EXPECT_EQ(grpc_response.timings(grpc_response.timings_size() - 1).stage(), "encode_map");
+
+  const auto rest = PostImage(*http_, "/v1/detect?frame_id=f1", frame);
+  ASSERT_TRUE(rest);
+  ASSERT_EQ(rest->status, 200) << rest->body;
+  EXPECT_EQ(rest->get_header_value("Content-Type"), "application/json");
+  const nlohmann::json json = nlohmann::json::parse(rest->body);
+  EXPECT_EQ(json["frame_id"], "f1");
+  EXPECT_EQ(json["model_version"], grpc_response.model_version());
+  EXPECT_EQ(json["width"], 320);
+  // The pipeline is deterministic: same obstacles, same proposals, same map.
+  ASSERT_EQ(json["obstacles"].size(), static_cast<size_t>(grpc_response.obstacles_size()));
+  for (int i = 0; i < grpc_response.obstacles_size(); ++i) {
+    EXPECT_EQ(json["obstacles"][i]["box"]["x"], grpc_response.obstacles(i).box().x());
+    EXPECT_EQ(json["obstacles"][i]["area"], grpc_response.obstacles(i).area());
+  }
+  ASSERT_EQ(json["proposals"].size(), static_cast<size_t>(grpc_response.proposals_size()));
+  for (int i = 0; i < grpc_response.proposals_size(); ++i) {
+    EXPECT_EQ(json["proposals"][i]["box"]["y"], grpc_response.proposals(i).box().y());
+    EXPECT_FLOAT_EQ(json["proposals"][i]["fused"].get<float>(), grpc_response.proposals(i).fused());
+  }
+  const auto map = PostImage(*http_, "/v1/probability-map", frame);
+  ASSERT_TRUE(map);
+  ASSERT_EQ(map->status, 200);
+  EXPECT_EQ(map->get_header_value("Content-Type"), "image/png");
+  EXPECT_EQ(map->body, grpc_response.probability_map().png());
+  const cv::Mat decoded =
+      cv::imdecode(std::vector<uchar>(map->body.begin(), map->body.end()), cv::IMREAD_UNCHANGED);
+  EXPECT_EQ(decoded.size(), cv::Size(320, 160));
+
+  // map=none / MAP_FORMAT_NONE: no map bytes.
+  const auto no_map = PostImage(*http_, "/v1/detect?map=none&max_proposals=2", frame);
+  ASSERT_TRUE(no_map);
+  ASSERT_EQ(no_map->status, 200);
+  const nlohmann::json no_map_json = nlohmann::json::parse(no_map->body);
+  EXPECT_FALSE(no_map_json.contains("probability_map")) << "no map requested, none sent";
+  EXPECT_LE(no_map_json["proposals"].size(), 2u);
+}
+
+TEST_F(ServiceE2ETest, StreamAnswersEveryFrameInOrder) {
+  std::vector<tod::v1::DetectRequest> requests;
+  for (int i = 0; i < 4; ++i) {
+    requests.push_back(MakeRequest(
+        testing::Encode(testing::RoadFrame(320, 160, 40 + 50 * i, 100), i % 2 ? ".jpg" : ".png"),
+        "cam0-" + std::to_string(i)));
+  }
+  std::vector<std::string> ids;
+  const grpc::Status status = grpc_->DetectStream(
+      requests,
+      [&](const tod::v1::DetectResponse& response) { ids.push_back(response.frame_id()); });
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(ids, (std::vector<std::string>{"cam0-0", "cam0-1", "cam0-2", "cam0-3"}));
+}
+
+TEST_F(ServiceE2ETest, ClientToolWritesOutputsAndReportsHealth) {
+  const std::string dir = testing::MakeTempDir("tod_client_e2e");
+  fs::create_directories(dir + "/in");
+  std::ofstream(dir + "/in/a.png", std::ios::binary) << testing::RoadPng();
+  std::ofstream(dir + "/in/b.jpg", std::ios::binary)
+      << testing::Encode(testing::RoadFrame(), ".jpg");
+  const std::string client = testing::BinaryPath("tod_client");
+  for (const std::string command : {"detect", "stream"}) {
+    const auto run = RunCommand({client, command, "--addr", server_->grpc_address(), dir + "/in",
+                                 "--out", dir + "/" + command});
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    for (const std::string stem : {"a", "b"}) {
+      const std::string base = dir + "/" + command + "/" + stem;
+      ASSERT_TRUE(fs::exists(base + ".json")) << base;
+      const nlohmann::json json = nlohmann::json::parse(std::ifstream(base + ".json"));
+      EXPECT_EQ(json["width"], 320);
+      const cv::Mat map = cv::imread(base + ".map.png", cv::IMREAD_UNCHANGED);
+      EXPECT_EQ(map.size(), cv::Size(320, 160));
+      const cv::Mat overlay = cv::imread(base + ".overlay.png");
+      EXPECT_EQ(overlay.size(), cv::Size(320, 160));
+    }
+  }
+  const auto health = RunCommand({client, "health", "--addr", server_->grpc_address()});
+  EXPECT_EQ(health.exit_code, 0) << health.output;
+  EXPECT_NE(health.output.find("SERVING"), std::string::npos);
+  const auto info = RunCommand({client, "info", "--addr", server_->grpc_address()});
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("\"generation\": 1"), std::string::npos) << info.output;
+  // Nobody listens on this port: health must fail (exit 1), not hang or crash.
+  const auto unreachable = RunCommand(
+      {client, "health", "--addr", "127.0.0.1:" + std::to_string(testing::FreeLoopbackPort())});
+  EXPECT_EQ(unreachable.exit_code, 1) << unreachable.output;
+}
+
+TEST_F(ServiceE2ETest, ModelInfoHealthAndMetrics) {
+  tod::v1::ModelInfo info;
+  ASSERT_TRUE(grpc_->GetModelInfo(&info).ok());
+  EXPECT_EQ(info.generation(), 1);
+  EXPECT_EQ(info.model_dir(), TestModel());
+  EXPECT_FALSE(info.manifest_json().empty());
+  const auto rest = http_->Get("/v1/model");
+  ASSERT_TRUE(rest);
+  ASSERT_EQ(rest->status, 200);
+  const nlohmann::json json = nlohmann::json::parse(rest->body);
+  EXPECT_EQ(json["version"], info.version());
+  EXPECT_EQ(json["name"], info.name());
+
+  grpc::health::v1::HealthCheckResponse health;
+  ASSERT_TRUE(grpc_->Health("", &health).ok());
+  EXPECT_EQ(health.status(), grpc::health::v1::HealthCheckResponse::SERVING);
+  ASSERT_TRUE(grpc_->Health("tod.v1.ObstacleDiscovery", &health).ok());
+  EXPECT_EQ(health.status(), grpc::health::v1::HealthCheckResponse::SERVING);
+  EXPECT_EQ(http_->Get("/v2/health/live")->status, 200);
+  EXPECT_EQ(http_->Get("/v2/health/ready")->status, 200);
+
+  tod::v1::DetectResponse response;
+  ASSERT_TRUE(grpc_->Detect(MakeRequest(testing::RoadPng()), &response).ok());
+  const std::string metrics = ScrapeMetrics(server_->http_port());
+  EXPECT_GE(MetricValue(metrics, R"(tod_requests_total{code="OK",protocol="grpc"})").value_or(0), 1)
+      << metrics;
+  EXPECT_NE(metrics.find("tod_request_duration_seconds_bucket"), std::string::npos);
+  EXPECT_NE(metrics.find("tod_queue_duration_seconds_count"), std::string::npos);
+  EXPECT_NE(metrics.find(R"(tod_stage_duration_seconds_count{stage="decode"})"), std::string::npos);
+  EXPECT_NE(metrics.find("tod_queue_depth"), std::string::npos);
+  EXPECT_NE(metrics.find("tod_in_flight_requests"), std::string::npos);
+  EXPECT_NE(metrics.find("tod_model_info{"), std::string::npos);
+  EXPECT_NE(metrics.find(R"(generation="1")"), std::string::npos);
+}
+
+TEST_F(ServiceE2ETest, RestErrorsHaveCodesAndMessages) {
+  struct Case {
+    std::string path;
+    std::string body;
+    std::string type;
+    int status;
+    std::string message_part;
+  };
+  const std::string png = testing::RoadPng();
+  const std::vector<Case> cases = {
+      {"/v1/detect", "", "image/png", 400, "empty"},
+      {"/v1/detect", "this is not an image", "image/jpeg", 400, "not a JPEG or PNG"},
+      {"/v1/detect", png.substr(0, png.size() / 2), "image/png", 400, "decode"},
+      {"/v1/detect", png, "text/plain", 415, "Content-Type"},
+      {"/v1/detect", std::string(kMaxBytes + 10, 'x'), "image/png", 413, "bytes"},
+      {"/v1/detect", testing::RoadPng(701, 400), "image/png", 413, "pixels"},
+      {"/v1/detect?obstacle_threshold=2", png, "image/png", 400, "obstacle_threshold"},
+      {"/v1/detect?max_proposals=abc", png, "image/png", 400, "max_proposals"},
+      {"/v1/detect?map=jpeg", png, "image/png", 400, "map"},
+      {"/v1/probability-map", "", "image/png", 400, "empty"},
+      {"/v1/nothing-here", png, "image/png", 404, "no such endpoint"},
+  };
+  for (const Case& c : cases) {
+    const auto result = PostImage(*http_, c.path, c.body, c.type);
+    ASSERT_TRUE(result) << c.path;
+    EXPECT_EQ(result->status, c.status) << c.path << " " << c.type << ": " << result->body;
+    EXPECT_NE(ErrorMessage(result).find(c.message_part), std::string::npos)
+        << c.path << ": " << result->body;
+  }
+  ExpectStillServes();
+}
+
+TEST_F(ServiceE2ETest, GrpcErrorsHaveCodesAndMessages) {
+  tod::v1::DetectResponse response;
+  grpc::Status status = grpc_->Detect(MakeRequest(""), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("empty"), std::string::npos);
+
+  status = grpc_->Detect(MakeRequest("garbage bytes"), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  status = grpc_->Detect(MakeRequest(std::string(kMaxBytes + 10, 'x')), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(status.error_message().find("over the limit"), std::string::npos)
+      << status.error_message();
+
+  status = grpc_->Detect(MakeRequest(testing::RoadPng(701, 400)), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(status.error_message().find("pixels"), std::string::npos);
+
+  tod::v1::DetectRequest bad_option = MakeRequest(testing::RoadPng());
+  bad_option.mutable_options()->set_obstacle_threshold(-0.5f);
+  status = grpc_->Detect(bad_option, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  // A bad frame in a stream ends that stream with the frame's status; the server goes on.
+  std::vector<tod::v1::DetectRequest> stream = {MakeRequest(testing::RoadPng(), "ok"),
+                                                MakeRequest("junk", "bad")};
+  int answered = 0;
+  status = grpc_->DetectStream(stream, [&](const tod::v1::DetectResponse&) { ++answered; });
+  EXPECT_EQ(answered, 1);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("frame 1"), std::string::npos) << status.error_message();
+  ExpectStillServes();
+}
+
+TEST_F(ServiceE2ETest, LoadGeneratorReportsGrpcAndHttp) {
+  const std::string dir = testing::MakeTempDir("tod_load_e2e");
+  std::ofstream(dir + "/a.png", std::ios::binary) << testing::RoadPng();
+  std::ofstream(dir + "/b.jpg", std::ios::binary) << testing::Encode(testing::RoadFrame(), ".jpg");
+  const std::string load = testing::BinaryPath("tod_load");
+  const std::vector<std::vector<std::string>> runs = {
+      {load, "--addr", server_->grpc_address(), "--images", dir, "--concurrency", "2", "--duration",
+       "1", "--warmup", "0.2", "--json", dir + "/grpc.json"},
+      {load, "--addr", "127.0.0.1:" + std::to_string(server_->http_port()), "--http", "--images",
+       dir, "--rate", "10", "--duration", "1", "--warmup", "0", "--json", dir + "/http.json"}};
+  for (const auto& argv : runs) {
+    const auto run = RunCommand(argv);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("p99"), std::string::npos) << run.output;
+    const nlohmann::json report = nlohmann::json::parse(std::ifstream(argv.back()));
+    EXPECT_GT(report["requests"].get<int>(), 0);
+    EXPECT_EQ(report["requests"], report["succeeded"]) << report.dump();
+    EXPECT_GT(report["latency_ms"]["p50"].get<double>(), 0);
+    EXPECT_LE(report["latency_ms"]["p50"].get<double>(), report["latency_ms"]["max"].get<double>());
+  }
+  const nlohmann::json open_loop = nlohmann::json::parse(std::ifstream(dir + "/http.json"));
+  EXPECT_EQ(open_loop["mode"], "open");
+  EXPECT_EQ(open_loop["codes"]["200"], open_loop["requests"]);
+  EXPECT_EQ(open_loop["requests"], 10);  // 10/s for 1 s, every scheduled request answered
+}
+
+}  // namespace
+}  // namespace tod::server
