@@ -132,6 +132,12 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
     EXPECT_TRUE(j["regression"][v]["ar"].contains("1000"));
   }
   EXPECT_GT(j["timing_ms"]["total"].get<double>(), 0.0);
+  // Floors a broken stage would miss (the fixture model scores about 0.33 TPR at FPR 0.03,
+  // 0.16 AR at 1000 after fusion and 0.12 AR for the MS proposals): a model that learned
+  // nothing, or a stage that drops the obstacles, falls far below them.
+  EXPECT_GE(j["regression"]["BP+Fusion@4"]["tpr_at_fpr"]["0.030"].get<double>(), 0.15);
+  EXPECT_GE(j["regression"]["BP+Fusion@4"]["ar"]["1000"].get<double>(), 0.06);
+  EXPECT_GE(j["proposals"]["OAOCC+OLP@4+MS"]["ar"]["1000"].get<double>(), 0.05);
   for (const char* png : {"recall_vs_proposals.png", "recall_vs_iou.png", "ar_vs_proposals.png",
                           "pixel_roc.png"})
     EXPECT_FALSE(cv::imread((out_ / "plots" / png).string()).empty()) << png;
