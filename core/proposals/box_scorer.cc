@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/proposals/edge_orientation.h"
 
@@ -37,60 +38,65 @@ BoxScorer::BoxScorer(const cv::Mat1f& edge_map, const EdgeBoxParams& params, int
     : width_(edge_map.cols),
       height_(edge_map.rows),
       params_(params),
-      refine_ratio_((1.f - params.alpha) / (1.f + params.alpha)),
-      groups_(BuildEdgeGroups(edge_map, ComputeEdgeOrientation(edge_map), GroupParamsOf(params))) {
-  BuildIntegralImages(edge_map);
-  bound_ = ContainmentBound(groups_, edge_map, params.edge_min_mag);
-  BuildRunIndexes();
-  norm_.resize(static_cast<size_t>(width_ + height_) / 2 + 2);
-  norm_[0] = 0.f;  // a box narrower than 3 x 3 pixels has no inner part to normalise: score 0
-  for (size_t i = 1; i < norm_.size(); ++i) {
-    norm_[i] = std::pow(1.f / static_cast<float>(i), params.kappa);
+      refine_ratio_((1.f - params.alpha) / (1.f + params.alpha)) {
+  auto tables = std::make_shared<Tables>();
+  Tables& t = *tables;
+  t.groups = BuildEdgeGroups(edge_map, ComputeEdgeOrientation(edge_map, params.edge_min_mag),
+                             GroupParamsOf(params));
+  BuildIntegralImages(edge_map, t);
+  t.bound = ContainmentBound(t.groups, edge_map, params.edge_min_mag);
+  BuildRunIndexes(t);
+  t.norm.resize(static_cast<size_t>(width_ + height_) / 2 + 2);
+  t.norm[0] = 0.f;  // a box narrower than 3 x 3 pixels has no inner part to normalise: score 0
+  for (size_t i = 1; i < t.norm.size(); ++i) {
+    t.norm[i] = std::pow(1.f / static_cast<float>(i), params.kappa);
   }
-  BuildWalkGraph();
+  BuildWalkGraph(t);
+  tables_ = std::move(tables);
+  t_ = tables_.get();
 }
 
-void BoxScorer::BuildWalkGraph() {
-  const int n = groups_.count() + 1;
+void BoxScorer::BuildWalkGraph(Tables& t) {
+  const int n = t.groups.count() + 1;
   nodes_.assign(n, Node{});
   for (int g = 1; g < n; ++g) {
-    nodes_[g].anchor_x = groups_.anchor_x[g];
-    nodes_[g].anchor_y = groups_.anchor_y[g];
-    nodes_[g].magnitude = groups_.magnitude[g];
+    nodes_[g].anchor_x = t.groups.anchor_x[g];
+    nodes_[g].anchor_y = t.groups.anchor_y[g];
+    nodes_[g].magnitude = t.groups.magnitude[g];
   }
   // A walk weight is at most 1, so an edge with affinity < 0.05 never passes the 0.05 cut.
-  walk_edge_begin_.assign(n + 1, 0);
-  walk_edges_.clear();
+  t.walk_edge_begin.assign(n + 1, 0);
+  t.walk_edges.clear();
   for (int g = 0; g < n; ++g) {
-    for (int k = groups_.affinity_begin[g]; k < groups_.affinity_begin[g + 1]; ++k) {
-      if (groups_.affinity_value[k] >= kMinPathWeight) {
-        walk_edges_.push_back({groups_.affinity_target[k], groups_.affinity_value[k]});
+    for (int k = t.groups.affinity_begin[g]; k < t.groups.affinity_begin[g + 1]; ++k) {
+      if (t.groups.affinity_value[k] >= kMinPathWeight) {
+        t.walk_edges.push_back({t.groups.affinity_target[k], t.groups.affinity_value[k]});
       }
     }
-    walk_edge_begin_[g + 1] = static_cast<int>(walk_edges_.size());
+    t.walk_edge_begin[g + 1] = static_cast<int>(t.walk_edges.size());
   }
   walk_.assign(n, WalkEntry{});
   queue_.assign(n, 0);  // a slot is queued at most once at a time
   ring_size_ = n;
 }
 
-void BoxScorer::BuildIntegralImages(const cv::Mat1f& edge_map) {
+void BoxScorer::BuildIntegralImages(const cv::Mat1f& edge_map, Tables& t) {
   const size_t stride = static_cast<size_t>(height_) + 1;
   const size_t n = (static_cast<size_t>(width_) + 1) * stride;
   // Per-pixel values first (column-major, offset by one), then the running sums.
-  anchor_mag_integral_.assign(n, 0.0);
-  edge_mag_integral_.assign(n, 0.0);
-  for (int s = 1; s <= groups_.count(); ++s) {
-    anchor_mag_integral_[(groups_.anchor_x[s] + 1) * stride + groups_.anchor_y[s] + 1] +=
-        groups_.magnitude[s];
+  t.anchor_mag_integral.assign(n, 0.0);
+  t.edge_mag_integral.assign(n, 0.0);
+  for (int s = 1; s <= t.groups.count(); ++s) {
+    t.anchor_mag_integral[(t.groups.anchor_x[s] + 1) * stride + t.groups.anchor_y[s] + 1] +=
+        t.groups.magnitude[s];
   }
   for (int r = 0; r < height_; ++r) {
     const float* e = edge_map[r];
     for (int c = 0; c < width_; ++c) {
-      if (e[c] > params_.edge_min_mag) edge_mag_integral_[(c + 1) * stride + r + 1] = e[c];
+      if (e[c] > params_.edge_min_mag) t.edge_mag_integral[(c + 1) * stride + r + 1] = e[c];
     }
   }
-  for (std::vector<double>* integral : {&anchor_mag_integral_, &edge_mag_integral_}) {
+  for (std::vector<double>* integral : {&t.anchor_mag_integral, &t.edge_mag_integral}) {
     std::vector<double>& I = *integral;
     for (int c = 1; c <= width_; ++c) {
       double column_sum = 0.0;
@@ -102,25 +108,48 @@ void BoxScorer::BuildIntegralImages(const cv::Mat1f& edge_map) {
   }
 }
 
-void BoxScorer::BuildRunIndexes() {
-  const cv::Mat1i& ids = groups_.ids;
-  row_run_index_.resize(static_cast<size_t>(width_) * height_);
-  col_run_index_.resize(static_cast<size_t>(width_) * height_);
-  row_run_group_.clear();
-  col_run_group_.clear();
-  for (int r = 0; r < height_; ++r) {
-    for (int c = 0; c < width_; ++c) {
-      if (c == 0 || ids(r, c) != ids(r, c - 1)) row_run_group_.push_back(ids(r, c));
-      row_run_index_[static_cast<size_t>(r) * width_ + c] =
-          static_cast<int>(row_run_group_.size()) - 1;
+namespace {
+
+// Appends the runs of non-zero ids of one line (values at line[i * step], i < length) to `runs`,
+// plus the sentinel, and sets first_run[i] (at first_run[i * 1]) to the index of the first run
+// ending at or after i.
+template <typename Run>
+void IndexLine(const int* line, int length, int step, std::vector<Run>& runs, int* first_run) {
+  const int base = static_cast<int>(runs.size());
+  std::vector<int> ends;
+  for (int i = 0; i < length; ++i) {
+    const int id = line[static_cast<size_t>(i) * step];
+    if (id <= 0) continue;
+    if (i > 0 && line[static_cast<size_t>(i - 1) * step] == id) {
+      ends.back() = i;
+      continue;
     }
+    runs.push_back(Run{i, id});
+    ends.push_back(i);
   }
+  runs.push_back(Run{std::numeric_limits<int>::max(), 0});
+  size_t k = 0;
+  for (int i = 0; i < length; ++i) {
+    while (k < ends.size() && ends[k] < i) ++k;
+    first_run[i] = base + static_cast<int>(k);
+  }
+}
+
+}  // namespace
+
+void BoxScorer::BuildRunIndexes(Tables& t) {
+  const cv::Mat1i& ids = t.groups.ids;  // continuous: a cv::Mat1i we built ourselves
+  t.row_first_run.assign(static_cast<size_t>(width_) * height_, 0);
+  t.col_first_run.assign(static_cast<size_t>(width_) * height_, 0);
+  t.row_runs.clear();
+  t.col_runs.clear();
+  for (int r = 0; r < height_; ++r) {
+    IndexLine(ids[r], width_, 1, t.row_runs, &t.row_first_run[static_cast<size_t>(r) * width_]);
+  }
+  const int step = static_cast<int>(ids.step1());
   for (int c = 0; c < width_; ++c) {
-    for (int r = 0; r < height_; ++r) {
-      if (r == 0 || ids(r, c) != ids(r - 1, c)) col_run_group_.push_back(ids(r, c));
-      col_run_index_[static_cast<size_t>(c) * height_ + r] =
-          static_cast<int>(col_run_group_.size()) - 1;
-    }
+    IndexLine(ids[0] + c, height_, step, t.col_runs,
+              &t.col_first_run[static_cast<size_t>(c) * height_]);
   }
 }
 
@@ -132,30 +161,83 @@ double BoxScorer::RectSum(const std::vector<double>& integral, int r0, int c0, i
          integral[left + r0];
 }
 
-void BoxScorer::Score(ScoreWindow& w, float bar) {
+void BoxScorer::Score(ScoreWindow& w, float bar) { ScoreImpl(w, bar, true); }
+
+void BoxScorer::ScoreImpl(ScoreWindow& w, float bar, bool use_bound) {
   w.score = 0.f;
   w.r0 = std::clamp(w.r0, 0, height_ - 1);
   w.r1 = std::clamp(w.r1, 0, height_ - 1);
   w.c0 = std::clamp(w.c0, 0, width_ - 1);
   w.c1 = std::clamp(w.c1, 0, width_ - 1);
   if (w.r1 < w.r0 || w.c1 < w.c0) return;
-  // Magnitude of the groups anchored inside, minus the edges of the centre box of half the size
-  // (offset by a quarter): edges there say nothing about an object boundary (§4.2.4).
+  // The centre box of half the size (offset by a quarter), whose edges are subtracted (§4.2.4).
   const int half_h = (w.r1 - w.r0) / 2, half_w = (w.c1 - w.c0) / 2;
   const int inner_r0 = w.r0 + half_h / 2, inner_c0 = w.c0 + half_w / 2;
   const int inner_r1 = inner_r0 + half_h, inner_c1 = inner_c0 + half_w;
-  const float norm = norm_[half_w + half_h];
+  const float norm = t_->norm[half_w + half_h];
   // The containment bound ends most windows here, before the exact sums and the walk.
-  if (Hopeless(bound_.Bound(w.r0, w.c0, w.r1, w.c1, inner_r0, inner_c0, inner_r1, inner_c1), norm,
-               bar)) {
+  if (use_bound &&
+      Hopeless(t_->bound.Bound(w.r0, w.c0, w.r1, w.c1, inner_r0, inner_c0, inner_r1, inner_c1),
+               norm, bar)) {
     return;
   }
-  double v = RectSum(anchor_mag_integral_, w.r0, w.c0, w.r1, w.c1) -
-             RectSum(edge_mag_integral_, inner_r0, inner_c0, inner_r1, inner_c1);
+  w.score = ScoreAfterBound(w, inner_r0, inner_c0, inner_r1, inner_c1, norm, bar);
+}
+
+void BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
+                            std::vector<ScoreWindow>& nonzero) {
+  // Score() on each window of the column, with the per-column work hoisted: the clamped
+  // columns, the centre box's columns and the bound's integral-image columns.
+  const int c0 = std::clamp(x, 0, width_ - 1), c1 = std::clamp(x + box_width, 0, width_ - 1);
+  const int half_w = (c1 - c0) / 2;
+  const int inner_c0 = c0 + half_w / 2, inner_c1 = inner_c0 + half_w;
+  const ContainmentBound::Columns columns = t_->bound.ColumnsOf(c0, c1, inner_c0, inner_c1);
+  const auto score_rest = [&](int r0, int r1, int inner_r0, int inner_r1, float norm) {
+    const ScoreWindow w{r0, c0, r1, c1, 0.f};
+    const float score = ScoreAfterBound(w, inner_r0, inner_c0, inner_r1, inner_c1, norm, -1.f);
+    if (score > 0.f) nonzero.push_back(ScoreWindow{r0, c0, r1, c1, score});
+  };
+  const int y_end = height_ - box_height + stride_y;
+  int y = 0;
+  // Windows that need no clamping share their size, so the bound test is one integer compare
+  // against the threshold that Hopeless() puts on the fixed-point bound.
+  const int unclamped_end = std::min(y_end, height_ - box_height);
+  if (box_height >= 0 && y < unclamped_end) {
+    const int half_h = box_height / 2, inner_offset = half_h / 2;
+    const float norm = t_->norm[half_w + half_h];
+    const std::int64_t threshold =
+        t_->bound.SmallestHopeful([&](double v) { return Hopeless(v, norm, -1.f); });
+    if (threshold == ContainmentBound::kNever) {
+      y = unclamped_end + (stride_y - unclamped_end % stride_y) % stride_y;  // none can pass
+    }
+    for (; y < unclamped_end; y += stride_y) {
+      const int inner_r0 = y + inner_offset;
+      if (!t_->bound.Reaches(columns, y, y + box_height, inner_r0, inner_r0 + half_h, threshold)) {
+        continue;
+      }
+      score_rest(y, y + box_height, inner_r0, inner_r0 + half_h, norm);
+    }
+  }
+  for (; y < y_end; y += stride_y) {  // the clamped windows at the bottom
+    const int r0 = std::min(y, height_ - 1), r1 = std::min(y + box_height, height_ - 1);
+    const int half_h = (r1 - r0) / 2;
+    const int inner_r0 = r0 + half_h / 2, inner_r1 = inner_r0 + half_h;
+    const float norm = t_->norm[half_w + half_h];
+    if (Hopeless(t_->bound.Bound(columns, r0, r1, inner_r0, inner_r1), norm, -1.f)) continue;
+    score_rest(r0, r1, inner_r0, inner_r1, norm);
+  }
+}
+
+float BoxScorer::ScoreAfterBound(const ScoreWindow& w, int inner_r0, int inner_c0, int inner_r1,
+                                 int inner_c1, float norm, float bar) {
+  // Magnitude of the groups anchored inside, minus the edges of the centre box: edges there say
+  // nothing about an object boundary (§4.2.4).
+  const double v = RectSum(t_->anchor_mag_integral, w.r0, w.c0, w.r1, w.c1) -
+                   RectSum(t_->edge_mag_integral, inner_r0, inner_c0, inner_r1, inner_c1);
   // The walk can only lower v: skip it when v alone cannot score highly (or beat the bar).
-  if (Hopeless(v, norm, bar)) return;
+  if (Hopeless(v, norm, bar)) return 0.f;
   ++past_early_exit_;
-  w.score = ScoreAfterEarlyExit(w, v, norm, bar);
+  return ScoreAfterEarlyExit(w, v, norm, bar);
 }
 
 float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm, float bar) {
@@ -175,10 +257,10 @@ float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm,
   queue_head_ = 0;
   queue_size_ = 0;
   removed_ = 0.0;
-  const auto add_boundary_runs = [&](const std::vector<int>& run_group, int first, int last) {
-    for (int i = first; i <= last; ++i) {
-      const int g = run_group[i];
-      if (g > 0 && nodes_[g].stamp != stamp_) AddWalkEntry(g, 1.f, AnchoredInside(nodes_[g], w));
+  const auto add_boundary_runs = [&](const Run* run, int last) {
+    for (; run->start <= last; ++run) {
+      const int g = run->group;
+      if (nodes_[g].stamp != stamp_) AddWalkEntry(g, 1.f, AnchoredInside(nodes_[g], w));
     }
   };
   const size_t top = static_cast<size_t>(w.r0) * width_;
@@ -186,13 +268,13 @@ float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm,
   const size_t left = static_cast<size_t>(w.c0) * height_;
   const size_t right = static_cast<size_t>(w.c1) * height_;
   // Check after every side: half of the walks end here, often before all four are read.
-  add_boundary_runs(row_run_group_, row_run_index_[top + w.c0], row_run_index_[top + w.c1]);
+  add_boundary_runs(&t_->row_runs[t_->row_first_run[top + w.c0]], w.c1);
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(row_run_group_, row_run_index_[bottom + w.c0], row_run_index_[bottom + w.c1]);
+  add_boundary_runs(&t_->row_runs[t_->row_first_run[bottom + w.c0]], w.c1);
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(col_run_group_, col_run_index_[left + w.r0], col_run_index_[left + w.r1]);
+  add_boundary_runs(&t_->col_runs[t_->col_first_run[left + w.r0]], w.r1);
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(col_run_group_, col_run_index_[right + w.r0], col_run_index_[right + w.r1]);
+  add_boundary_runs(&t_->col_runs[t_->col_first_run[right + w.r0]], w.r1);
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
 
   while (queue_size_ > 0) {
@@ -202,8 +284,8 @@ float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm,
     walk_[slot].queued = false;
     const float weight = walk_[slot].weight;
     const int s = walk_[slot].group;
-    const Affinity* edge = walk_edges_.data() + walk_edge_begin_[s];
-    const Affinity* const end = walk_edges_.data() + walk_edge_begin_[s + 1];
+    const Affinity* edge = t_->walk_edges.data() + t_->walk_edge_begin[s];
+    const Affinity* const end = t_->walk_edges.data() + t_->walk_edge_begin[s + 1];
     for (; edge != end; ++edge) {
       const float wt = weight * edge->value;
       if (wt < kMinPathWeight) continue;
@@ -239,11 +321,11 @@ void BoxScorer::Refine(ScoreWindow& box) {
   auto search = [this, &box](int ScoreWindow::*side, int step) {
     ScoreWindow candidate = box;
     candidate.*side -= step;
-    Score(candidate, box.score);
+    ScoreImpl(candidate, box.score, false);
     if (candidate.score <= box.score) {
       candidate = box;
       candidate.*side += step;
-      Score(candidate, box.score);
+      ScoreImpl(candidate, box.score, false);
     }
     if (candidate.score > box.score) box = candidate;
   };

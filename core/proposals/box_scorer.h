@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -19,6 +20,8 @@ struct ScoreWindow {
   float score = 0.f;
 };
 
+// Copies are cheap: they share the per-map tables and own only the walk scratch, so a threaded
+// caller gives each thread its own copy.
 class BoxScorer {
  public:
   // edge_map normalised to max 1 (non-finite values count as 0); params assumed valid
@@ -29,13 +32,18 @@ class BoxScorer {
   // bar >= 0 the caller only asks whether the score exceeds bar: a window that provably does
   // not gets score 0 without finishing its walk; one that does gets its exact score.
   void Score(ScoreWindow& window, float bar = -1.f);
+  // Scores the sliding-window column at x of one window shape (nominal extent box_width x
+  // box_height, row stride stride_y; rows y = 0, stride_y, ... while y < height - box_height +
+  // stride_y) exactly as Score() would, and appends the clamped windows with a non-zero score.
+  void ScoreColumn(int x, int box_width, int box_height, int stride_y,
+                   std::vector<ScoreWindow>& nonzero);
   // Coordinate search on the four sides with halving steps, accepting improvements.
   void Refine(ScoreWindow& window);
 
   int width() const { return width_; }
   int height() const { return height_; }
-  const EdgeGroups& groups() const { return groups_; }
-  // How many Score calls got past the integral-image early exit.
+  const EdgeGroups& groups() const { return t_->groups; }
+  // How many scorings ran the boundary-affinity walk (past the bound and the early exit).
   long long past_early_exit() const { return past_early_exit_; }
 
  private:
@@ -53,6 +61,12 @@ class BoxScorer {
     int target = 0;
     float value = 0.f;
   };
+  // A run of pixels of one group along a row (column), from `start` to the next run; the runs
+  // of each row (column) end with a sentinel whose start lies beyond every pixel.
+  struct Run {
+    int start = 0;
+    int group = 0;
+  };
   struct WalkEntry {
     int group = 0;
     float weight = 0.f;
@@ -60,14 +74,40 @@ class BoxScorer {
     bool queued = false;
   };
 
-  void BuildIntegralImages(const cv::Mat1f& edge_map);
-  void BuildRunIndexes();
-  void BuildWalkGraph();
+  // Everything derived from the map once; read-only while scoring.
+  struct Tables {
+    EdgeGroups groups;
+    // Column-major integral images, index c * (height + 1) + r: the grid walks rows innermost.
+    std::vector<double> anchor_mag_integral;  // group magnitudes placed at their anchors
+    std::vector<double> edge_mag_integral;    // M where M > edge_min_mag
+    std::vector<float> norm;                  // (bw + bh)^(-kappa), index bw + bh
+    ContainmentBound bound;                   // skips most walks before they start
+    // Runs of one group (id > 0) along each row (column), in order: the groups touching the box
+    // side [c0, c1] of row r are those of the runs from row_first_run[r * width + c0] (the first
+    // run of row r that ends at or after c0) while their start is <= c1.
+    std::vector<Run> row_runs, col_runs;
+    std::vector<int> row_first_run;  // at r * width + c
+    std::vector<int> col_first_run;  // at c * height + r
+    // Affinity graph without the edges that can never carry a weight >= 0.05.
+    std::vector<int> walk_edge_begin;
+    std::vector<Affinity> walk_edges;
+  };
+
+  // Score() with the containment bound optional: Refine() skips it, because its candidates lie
+  // next to a box that scored, the bound rarely rejects them, and its loads cost more than the
+  // walks it saves (measured with bench_proposals_olp).
+  void ScoreImpl(ScoreWindow& window, float bar, bool use_bound);
+  void BuildIntegralImages(const cv::Mat1f& edge_map, Tables& t);
+  void BuildRunIndexes(Tables& t);
+  void BuildWalkGraph(Tables& t);
   // Sum over the inclusive rectangle of a column-major (width+1) x (height+1) integral image.
   double RectSum(const std::vector<double>& integral, int r0, int c0, int r1, int c1) const;
   bool AnchoredInside(const Node& n, const ScoreWindow& w) const {
     return n.anchor_x >= w.c0 && n.anchor_x <= w.c1 && n.anchor_y >= w.r0 && n.anchor_y <= w.r1;
   }
+  // The exact sums and the walk of a clamped window that passed the containment bound.
+  float ScoreAfterBound(const ScoreWindow& w, int inner_r0, int inner_c0, int inner_r1,
+                        int inner_c1, float norm, float bar);
   // The boundary-affinity walk of a clamped window whose inside magnitude v passed the early
   // exit; returns the final score (0 below min_score).
   float ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm, float bar);
@@ -88,8 +128,10 @@ class BoxScorer {
     Node& node = nodes_[group];
     node.stamp = stamp_;
     node.slot = walk_size_;
-    walk_[walk_size_] = WalkEntry{group, weight, inside, true};
-    Enqueue(walk_size_);
+    // A group without walk edges propagates nothing: it needs no turn in the queue.
+    const bool propagates = t_->walk_edge_begin[group] != t_->walk_edge_begin[group + 1];
+    walk_[walk_size_] = WalkEntry{group, weight, inside, propagates};
+    if (propagates) Enqueue(walk_size_);
     ++walk_size_;
     if (inside) removed_ += static_cast<double>(weight) * node.magnitude;
   }
@@ -98,19 +140,10 @@ class BoxScorer {
   int height_ = 0;
   EdgeBoxParams params_;
   float refine_ratio_ = 0.f;  // (1 - alpha) / (1 + alpha), unmodified by the stride factor
-  EdgeGroups groups_;
-  // Column-major integral images, index c * (height + 1) + r: the grid walks rows innermost.
-  std::vector<double> anchor_mag_integral_;  // group magnitudes placed at their anchors
-  std::vector<double> edge_mag_integral_;    // M where M > edge_min_mag
-  std::vector<float> norm_;                  // (bw + bh)^(-kappa), index bw + bh
-  ContainmentBound bound_;                   // skips most walks before they start
-  // Runs of equal group id along each row (column): the groups touching a box side are the
-  // runs between the run indexes of its two end pixels.
-  std::vector<int> row_run_group_, row_run_index_;  // run_index at r * width + c
-  std::vector<int> col_run_group_, col_run_index_;  // run_index at c * height + r
-  // Affinity graph without the edges that can never carry a weight >= 0.05.
-  std::vector<int> walk_edge_begin_;
-  std::vector<Affinity> walk_edges_;
+  // The per-map tables, shared by the copies a multi-threaded caller makes (copies only
+  // duplicate the walk scratch).
+  std::shared_ptr<const Tables> tables_;
+  const Tables* t_ = nullptr;  // tables_.get(), for short access in the hot paths
   // Scratch of the walk, sized by the group count and reused through stamp_.
   std::vector<Node> nodes_;
   std::vector<WalkEntry> walk_;

@@ -75,10 +75,11 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const cv::Mat1f& ed
       }
     }
   }
-  Accumulate(cells_, width, height, [](Cell& here, const Cell& up, const Cell& left,
-                                       const Cell& up_left) {
-    for (int k = 0; k < 4; ++k) here.corner[k] += up.corner[k] + left.corner[k] - up_left.corner[k];
-  });
+  Accumulate(cells_, width, height,
+             [](Cell& here, const Cell& up, const Cell& left, const Cell& up_left) {
+               for (int k = 0; k < 4; ++k)
+                 here.corner[k] += up.corner[k] + left.corner[k] - up_left.corner[k];
+             });
   Accumulate(edges_, width, height,
              [](std::uint32_t& here, std::uint32_t up, std::uint32_t left, std::uint32_t up_left) {
                here += up + left - up_left;

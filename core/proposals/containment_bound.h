@@ -17,6 +17,7 @@
 // double rounding of the exact score.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -31,34 +32,104 @@ class ContainmentBound {
   // edge_map: finite values; edge pixels are those > edge_min_mag (as in the score).
   ContainmentBound(const EdgeGroups& groups, const cv::Mat1f& edge_map, float edge_min_mag);
 
-  // Upper bound on v - removed of the clamped inclusive window [r0, r1] x [c0, c1] whose centre
-  // box is [ir0, ir1] x [ic0, ic1], including the rounding margin.
-  double Bound(int r0, int c0, int r1, int c1, int ir0, int ic0, int ir1, int ic1) const {
-    std::uint32_t corners = 0;  // a window without a strict interior contains no group
-    if (r1 - r0 >= 2 && c1 - c0 >= 2) {
-      const Cell& a = cells_[Index(r0 + 1, c0 + 1)];  // integral at the interior's corners
-      const Cell& b = cells_[Index(r0 + 1, c1)];
-      const Cell& c = cells_[Index(r1, c0 + 1)];
-      const Cell& d = cells_[Index(r1, c1)];
-      corners = d.corner[0] - b.corner[0] - c.corner[0] + a.corner[0];
-      for (int k = 1; k < 4; ++k) {
-        corners = std::min(corners, d.corner[k] - b.corner[k] - c.corner[k] + a.corner[k]);
-      }
-    }
-    const std::uint32_t inner = edges_[Index(ir1 + 1, ic1 + 1)] - edges_[Index(ir0, ic1 + 1)] -
-                                edges_[Index(ir1 + 1, ic0)] + edges_[Index(ir0, ic0)];
-    const double fixed = static_cast<double>(corners) - static_cast<double>(inner);
-    return fixed * inverse_scale_ + margin_;
-  }
-
- private:
   // Group magnitude at the four bounding-box corners: top-left, top-right, bottom-left,
   // bottom-right; one cache line fetch serves all four integrals.
   struct Cell {
     std::uint32_t corner[4] = {0, 0, 0, 0};
   };
+
+  // The integral-image columns one grid column of windows reads: computed once per column so
+  // that the per-window bound is a few loads.
+  struct Columns {
+    const Cell* left = nullptr;   // interior's first column
+    const Cell* right = nullptr;  // one past the interior's last column
+    const std::uint32_t* inner_left = nullptr;
+    const std::uint32_t* inner_right = nullptr;
+    bool has_interior = false;
+  };
+  // For windows spanning columns [c0, c1] with centre-box columns [ic0, ic1].
+  Columns ColumnsOf(int c0, int c1, int ic0, int ic1) const {
+    Columns v;
+    v.has_interior = c1 - c0 >= 2;
+    if (v.has_interior) {
+      v.left = &cells_[Index(0, c0 + 1)];
+      v.right = &cells_[Index(0, c1)];
+    }
+    v.inner_left = &edges_[Index(0, ic0)];
+    v.inner_right = &edges_[Index(0, ic1 + 1)];
+    return v;
+  }
+
+  // The bound in fixed-point units (corner minimum - centre-box edges) of the clamped inclusive
+  // window [r0, r1] x [c0, c1] whose centre box is [ir0, ir1] x [ic0, ic1] (columns as given to
+  // ColumnsOf). Monotone: ToMagnitude() turns it into the bound on v - removed.
+  std::int64_t FixedBound(const Columns& v, int r0, int r1, int ir0, int ir1) const {
+    std::uint32_t corners = 0;  // a window without a strict interior contains no group
+    if (v.has_interior && r1 - r0 >= 2) {
+      const Cell& a = v.left[r0 + 1];  // the integrals at the interior's four corners
+      const Cell& b = v.right[r0 + 1];
+      const Cell& c = v.left[r1];
+      const Cell& d = v.right[r1];
+      corners = d.corner[0] - b.corner[0] - c.corner[0] + a.corner[0];
+      for (int k = 1; k < 4; ++k) {
+        corners = std::min(corners, d.corner[k] - b.corner[k] - c.corner[k] + a.corner[k]);
+      }
+    }
+    return static_cast<std::int64_t>(corners) - InnerEdges(v, ir0, ir1);
+  }
+  // FixedBound(...) >= threshold, cheapest test first: most windows fail on one corner sum.
+  bool Reaches(const Columns& v, int r0, int r1, int ir0, int ir1, std::int64_t threshold) const {
+    if (!v.has_interior || r1 - r0 < 2) return -InnerEdges(v, ir0, ir1) >= threshold;
+    const Cell& a = v.left[r0 + 1];
+    const Cell& b = v.right[r0 + 1];
+    const Cell& c = v.left[r1];
+    const Cell& d = v.right[r1];
+    // Centre-box edges are >= 0, so a corner sum below the threshold already decides.
+    if (static_cast<std::int64_t>(d.corner[0] - b.corner[0] - c.corner[0] + a.corner[0]) <
+        threshold) {
+      return false;
+    }
+    const std::int64_t needed = threshold + InnerEdges(v, ir0, ir1);
+    for (int k = 0; k < 4; ++k) {
+      if (static_cast<std::int64_t>(d.corner[k] - b.corner[k] - c.corner[k] + a.corner[k]) <
+          needed) {
+        return false;
+      }
+    }
+    return true;
+  }
+  double ToMagnitude(std::int64_t fixed) const {
+    return static_cast<double>(fixed) * inverse_scale_ + margin_;
+  }
+  // The smallest fixed-point value whose magnitude a monotone test `hopeless` (true for small
+  // values) accepts, so that a hot loop can compare integers; kNever when none up to 2^32 does.
+  static constexpr std::int64_t kNever = std::int64_t{1} << 40;
+  template <typename Hopeless>
+  std::int64_t SmallestHopeful(Hopeless hopeless) const {
+    std::int64_t lo = -(std::int64_t{1} << 33), hi = std::int64_t{1} << 33;
+    if (!hopeless(ToMagnitude(lo))) return lo;
+    if (hopeless(ToMagnitude(hi))) return kNever;
+    while (hi - lo > 1) {  // hopeless(lo) and !hopeless(hi)
+      const std::int64_t mid = lo + (hi - lo) / 2;
+      (hopeless(ToMagnitude(mid)) ? lo : hi) = mid;
+    }
+    return hi;
+  }
+
+  // Upper bound on v - removed (magnitude units, with the rounding margin).
+  double Bound(const Columns& v, int r0, int r1, int ir0, int ir1) const {
+    return ToMagnitude(FixedBound(v, r0, r1, ir0, ir1));
+  }
+  double Bound(int r0, int c0, int r1, int c1, int ir0, int ic0, int ir1, int ic1) const {
+    return Bound(ColumnsOf(c0, c1, ic0, ic1), r0, r1, ir0, ir1);
+  }
+
+ private:
   // Column-major (width + 1) x (height + 1): the grid walks rows innermost.
   size_t Index(int r, int c) const { return static_cast<size_t>(c) * stride_ + r; }
+  std::int64_t InnerEdges(const Columns& v, int ir0, int ir1) const {
+    return v.inner_right[ir1 + 1] - v.inner_right[ir0] - v.inner_left[ir1 + 1] + v.inner_left[ir0];
+  }
 
   size_t stride_ = 0;
   double inverse_scale_ = 0.0;  // fixed point -> magnitude

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "core/proposals/box_scorer.h"
-#include "core/proposals/window_grid.h"
+#include "core/proposals/window_scan.h"
 
 namespace tod {
 namespace {
@@ -20,8 +20,6 @@ Status OutOfRange(const std::string& field, const std::string& range, double val
 bool Usable(const cv::Mat1f& map) {
   return !map.empty() && map.cols <= kMaxMapSide && map.rows <= kMaxMapSide;
 }
-
-Box ToBox(const ScoreWindow& w) { return Box{w.c0, w.r0, w.c1 - w.c0 + 1, w.r1 - w.r0 + 1}; }
 
 }  // namespace
 
@@ -46,6 +44,8 @@ Status ValidateEdgeBoxParams(const EdgeBoxParams& p) {
     return OutOfRange("stride_factor", "in (0, 1]", p.stride_factor);
   }
   if (p.min_stride < 1) return OutOfRange("min_stride", ">= 1", p.min_stride);
+  if (p.refine_limit < 0)
+    return OutOfRange("refine_limit", ">= 0 (0 = refine all)", p.refine_limit);
   if (p.threads < 0) return OutOfRange("threads", ">= 0 (0 = all cores)", p.threads);
   return Status::Ok();
 }
@@ -61,29 +61,8 @@ std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxPa
   s = EdgeBoxStats{};
   if (!Usable(edge_map) || !ValidateEdgeBoxParams(params).ok()) return {};
 
-  BoxScorer scorer(edge_map, params);
-  std::vector<ScoredBox> scored;
-  for (const WindowShape& shape : WindowShapes(edge_map.cols, edge_map.rows, params)) {
-    // Same bounds as the grid definition: the last window may overhang and is clamped.
-    const int x_end = edge_map.cols - shape.width + shape.stride_x;
-    const int y_end = edge_map.rows - shape.height + shape.stride_y;
-    for (int x = 0; x < x_end; x += shape.stride_x) {
-      for (int y = 0; y < y_end; y += shape.stride_y) {
-        ScoreWindow w{y, x, y + shape.height, x + shape.width, 0.f};
-        ++s.windows_visited;
-        const long long past_exit_before = scorer.past_early_exit();
-        scorer.Score(w);
-        s.windows_past_early_exit += scorer.past_early_exit() - past_exit_before;
-        if (w.score <= 0.f) continue;
-        ++s.windows_nonzero;
-        if (params.refine) scorer.Refine(w);
-        scored.push_back(ScoredBox{ToBox(w), w.score});
-      }
-    }
-  }
-  s.scorings = scorer.past_early_exit();
-  std::vector<ScoredBox> kept =
-      NonMaximumSuppression(std::move(scored), params.beta, params.max_boxes);
+  const BoxScorer scorer(edge_map, params);
+  std::vector<ScoredBox> kept = ScanWindowGrid(scorer, params, s);
   s.boxes_out = static_cast<long long>(kept.size());
   return kept;
 }

@@ -27,6 +27,11 @@ struct EdgeBoxParams {
   float stride_factor = 1.f;     // MS: (K - k + 1) / K for region k; 1 = plain sliding window
   int min_stride = 2;            // px
   bool refine = true;
+  // APPROXIMATION, off by default (0 = refine every window with a non-zero score, as Edge Boxes
+  // and the paper do). N > 0 refines only the N windows with the best grid scores; the others
+  // keep their grid box and score. Refinement is most of the scoring time; see
+  // bench_proposals_olp for the speed / recall trade-off.
+  int refine_limit = 0;
   // Worker threads for the window grid: 1 = the calling thread only, 0 = all hardware threads.
   // The output is identical for every value (deterministic merge, §4.2.8 NMS on a total order).
   int threads = 1;
@@ -40,7 +45,8 @@ Status ValidateEdgeBoxParams(const EdgeBoxParams& params);
 struct EdgeBoxStats {
   long long windows_visited = 0;          // grid windows scored
   long long windows_past_early_exit = 0;  // grid windows that reached the boundary-affinity walk
-  long long windows_nonzero = 0;          // grid windows with a final score > 0 (then refined)
+  long long windows_nonzero = 0;          // grid windows with a final score > 0
+  long long windows_refined = 0;          // of those, refined (all unless refine_limit)
   long long scorings = 0;                 // all scorings past the early exit, with refinement
   long long boxes_out = 0;                // after NMS / max_boxes
 };

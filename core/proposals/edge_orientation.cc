@@ -1,6 +1,7 @@
 #include "core/proposals/edge_orientation.h"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
 
@@ -53,6 +54,10 @@ cv::Mat1f DerivativeY(const cv::Mat1f& map) {
 }
 
 cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map) {
+  return ComputeEdgeOrientation(edge_map, -std::numeric_limits<float>::infinity());
+}
+
+cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map, float min_magnitude) {
   if (edge_map.empty()) return {};
   const cv::Mat1f smoothed = TriangleSmooth(edge_map);
   const cv::Mat1f ox = DerivativeX(smoothed);
@@ -61,9 +66,10 @@ cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map) {
   const cv::Mat1f oxy = DerivativeX(oy);
   const cv::Mat1f oyy = DerivativeY(oy);
   constexpr float kPi = std::numbers::pi_v<float>;
-  cv::Mat1f theta(edge_map.size());
+  cv::Mat1f theta(edge_map.size(), 0.f);
   for (int r = 0; r < edge_map.rows; ++r) {
     for (int c = 0; c < edge_map.cols; ++c) {
+      if (!(edge_map(r, c) > min_magnitude)) continue;
       float t = std::atan(oyy(r, c) * Sign(-oxy(r, c)) / (oxx(r, c) + 1e-5f));
       t = std::fmod(t, kPi);  // MATLAB mod: result takes the sign of the divisor
       if (t < 0.f) t += kPi;

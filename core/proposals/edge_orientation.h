@@ -12,6 +12,9 @@ namespace tod {
 //   theta = mod(atan(Oyy * sign(-Oxy) / (Oxx + 1e-5)), pi)   in [0, pi).
 // Empty input gives an empty result.
 cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map);
+// The same, but theta only where edge_map > min_magnitude (0 elsewhere): edge grouping reads
+// orientations of edge pixels only, and the per-pixel arctangent is the costly part.
+cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map, float min_magnitude);
 
 // Central differences in the interior, one-sided differences on the first / last column (row);
 // a single column (row) has zero derivative. Exposed for tests.

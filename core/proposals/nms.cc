@@ -14,127 +14,120 @@
 #include <numeric>
 
 #include "core/proposals/edge_box_scorer.h"
+#include "core/proposals/greedy_nms.h"
 
 namespace tod {
 namespace {
 
-class KeptBoxIndex {
- public:
-  KeptBoxIndex(const std::vector<ScoredBox>& boxes, float iou_threshold)
-      : threshold_(iou_threshold) {
-    // The bounds only hold for thresholds in (0, 1); otherwise one flat list (plain greedy NMS).
-    if (!(iou_threshold > 0.f && iou_threshold < 1.f)) return;
-    log_step_ = std::log(1.0 / static_cast<double>(iou_threshold));
-    // Suppressed() adds 2 px of slack for the rounding of the IoU division.
-    radius_factor_ = (1.0 - iou_threshold) / iou_threshold;
-    min_x_ = min_y_ = max_x_ = max_y_ = 0;
-    bool first = true;
-    for (const ScoredBox& b : boxes) {
-      if (b.box.empty()) continue;
-      min_x_ = first ? b.box.x : std::min(min_x_, b.box.x);
-      min_y_ = first ? b.box.y : std::min(min_y_, b.box.y);
-      max_x_ = first ? b.box.x : std::max(max_x_, b.box.x);
-      max_y_ = first ? b.box.y : std::max(max_y_, b.box.y);
-      first = false;
-    }
-    grids_.resize(kBinCount);
-  }
-
-  // True when some kept box has IoU > threshold with the candidate.
-  bool Suppressed(const Box& candidate) const {
-    if (grids_.empty()) {
-      return std::any_of(flat_.begin(), flat_.end(),
-                         [&](const Box& k) { return BoxIoU(candidate, k) > threshold_; });
-    }
-    if (candidate.empty()) return false;  // IoU 0 with everything
-    const int bin = BinOf(candidate);
-    const long long rx = static_cast<long long>(radius_factor_ * candidate.w) + 2;
-    const long long ry = static_cast<long long>(radius_factor_ * candidate.h) + 2;
-    for (int b = std::max(0, bin - 1); b <= std::min(kBinCount - 1, bin + 1); ++b) {
-      const Grid& g = grids_[b];
-      if (g.head.empty()) continue;
-      const int gx0 = g.CellX(candidate.x - rx - min_x_), gx1 = g.CellX(candidate.x + rx - min_x_);
-      const int gy0 = g.CellY(candidate.y - ry - min_y_), gy1 = g.CellY(candidate.y + ry - min_y_);
-      for (int gx = gx0; gx <= gx1; ++gx) {
-        for (int gy = gy0; gy <= gy1; ++gy) {
-          for (int e = g.head[static_cast<size_t>(gx) * g.rows + gy]; e >= 0; e = entries_[e].next) {
-            if (BoxIoU(candidate, entries_[e].box) > threshold_) return true;
-          }
-        }
-      }
-    }
-    return false;
-  }
-
-  void Add(const Box& kept) {
-    if (grids_.empty()) {
-      flat_.push_back(kept);
-      return;
-    }
-    if (kept.empty()) return;  // suppresses nothing
-    Grid& g = grids_[BinOf(kept)];
-    if (g.head.empty()) g = MakeGrid(BinOf(kept));
-    const size_t cell = static_cast<size_t>(g.CellX(kept.x - min_x_)) * g.rows +
-                        g.CellY(kept.y - min_y_);
-    entries_.push_back({kept, g.head[cell]});
-    g.head[cell] = static_cast<int>(entries_.size()) - 1;
-  }
-
- private:
-  static constexpr int kBinCount = 4096;  // log(area) / log(1/t) stays far below this
-  static constexpr long long kMaxCells = 1 << 22;
-  struct Entry {
-    Box box;
-    int next = -1;  // next entry in the same cell
-  };
-  struct Grid {
-    long long cell = 1;  // side in pixels
-    int cols = 0, rows = 0;
-    std::vector<int> head;  // first entry per cell (column-major), -1 = none
-    int CellX(long long offset) const {
-      return static_cast<int>(std::clamp<long long>(offset / cell, 0, cols - 1));
-    }
-    int CellY(long long offset) const {
-      return static_cast<int>(std::clamp<long long>(offset / cell, 0, rows - 1));
-    }
-  };
-
-  int BinOf(const Box& b) const {
-    const double bin = std::floor(std::log(static_cast<double>(b.area())) / log_step_);
-    return static_cast<int>(std::clamp(bin, 0.0, static_cast<double>(kBinCount - 1)));
-  }
-
-  // Cells of about half the side of a square box of the bin's smallest area: a candidate then
-  // scans two or three cells per axis.
-  Grid MakeGrid(int bin) const {
-    Grid g;
-    g.cell = std::max(2LL, static_cast<long long>(0.5 * std::exp(0.5 * bin * log_step_)));
-    const long long span_x = static_cast<long long>(max_x_) - min_x_ + 1;
-    const long long span_y = static_cast<long long>(max_y_) - min_y_ + 1;
-    while ((span_x / g.cell + 1) * (span_y / g.cell + 1) > kMaxCells) g.cell *= 2;
-    g.cols = static_cast<int>(span_x / g.cell + 1);
-    g.rows = static_cast<int>(span_y / g.cell + 1);
-    g.head.assign(static_cast<size_t>(g.cols) * g.rows, -1);
-    return g;
-  }
-
-  float threshold_;
-  double log_step_ = 0.0;
-  double radius_factor_ = 0.0;
-  int min_x_ = 0, min_y_ = 0, max_x_ = 0, max_y_ = 0;  // top-left corners of the input boxes
-  std::vector<Grid> grids_;                            // per area bin; empty = flat mode
-  std::vector<Entry> entries_;
-  std::vector<Box> flat_;
-};
+constexpr int kBinCount = 4096;  // log(area) / log(1/t) stays far below this
+constexpr long long kMaxCells = 1 << 22;
 
 }  // namespace
 
+GreedyNms::GreedyNms(float iou_threshold, int max_boxes, int min_x, int min_y, int max_x, int max_y)
+    : threshold_(iou_threshold),
+      max_boxes_(max_boxes),
+      min_x_(min_x),
+      min_y_(min_y),
+      max_x_(std::max(min_x, max_x)),
+      max_y_(std::max(min_y, max_y)) {
+  // The bounds only hold for thresholds in (0, 1); otherwise one flat list (plain greedy NMS).
+  if (!(iou_threshold > 0.f && iou_threshold < 1.f)) return;
+  log_step_ = std::log(1.0 / static_cast<double>(iou_threshold));
+  // Suppressed() adds 2 px of slack for the rounding of the IoU division.
+  radius_factor_ = (1.0 - iou_threshold) / iou_threshold;
+  grids_.resize(kBinCount);
+}
+
+bool GreedyNms::Offer(const ScoredBox& box) {
+  if (full() || Suppressed(box.box)) return false;
+  Add(box.box);
+  kept_.push_back(box);
+  return true;
+}
+
+int GreedyNms::Grid::CellX(long long offset) const {
+  return static_cast<int>(std::clamp<long long>(offset / cell, 0, cols - 1));
+}
+int GreedyNms::Grid::CellY(long long offset) const {
+  return static_cast<int>(std::clamp<long long>(offset / cell, 0, rows - 1));
+}
+
+bool GreedyNms::Suppressed(const Box& candidate) const {
+  if (grids_.empty()) {
+    return std::any_of(flat_.begin(), flat_.end(),
+                       [&](const Box& k) { return BoxIoU(candidate, k) > threshold_; });
+  }
+  if (candidate.empty()) return false;  // IoU 0 with everything
+  const int bin = BinOf(candidate);
+  const long long rx = static_cast<long long>(radius_factor_ * candidate.w) + 2;
+  const long long ry = static_cast<long long>(radius_factor_ * candidate.h) + 2;
+  for (int b = std::max(0, bin - 1); b <= std::min(kBinCount - 1, bin + 1); ++b) {
+    const Grid& g = grids_[b];
+    if (g.head.empty()) continue;
+    const int gx0 = g.CellX(candidate.x - rx - min_x_), gx1 = g.CellX(candidate.x + rx - min_x_);
+    const int gy0 = g.CellY(candidate.y - ry - min_y_), gy1 = g.CellY(candidate.y + ry - min_y_);
+    for (int gx = gx0; gx <= gx1; ++gx) {
+      for (int gy = gy0; gy <= gy1; ++gy) {
+        for (int e = g.head[static_cast<size_t>(gx) * g.rows + gy]; e >= 0; e = entries_[e].next) {
+          if (BoxIoU(candidate, entries_[e].box) > threshold_) return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
+void GreedyNms::Add(const Box& kept) {
+  if (grids_.empty()) {
+    flat_.push_back(kept);
+    return;
+  }
+  if (kept.empty()) return;  // suppresses nothing
+  const int bin = BinOf(kept);
+  Grid& g = grids_[bin];
+  if (g.head.empty()) g = MakeGrid(bin);
+  const size_t cell =
+      static_cast<size_t>(g.CellX(kept.x - min_x_)) * g.rows + g.CellY(kept.y - min_y_);
+  entries_.push_back({kept, g.head[cell]});
+  g.head[cell] = static_cast<int>(entries_.size()) - 1;
+}
+
+int GreedyNms::BinOf(const Box& b) const {
+  const double bin = std::floor(std::log(static_cast<double>(b.area())) / log_step_);
+  return static_cast<int>(std::clamp(bin, 0.0, static_cast<double>(kBinCount - 1)));
+}
+
+// Cells of about half the side of a square box of the bin's smallest area: a candidate then
+// scans two or three cells per axis.
+GreedyNms::Grid GreedyNms::MakeGrid(int bin) const {
+  Grid g;
+  g.cell = std::max(2LL, static_cast<long long>(0.5 * std::exp(0.5 * bin * log_step_)));
+  const long long span_x = static_cast<long long>(max_x_) - min_x_ + 1;
+  const long long span_y = static_cast<long long>(max_y_) - min_y_ + 1;
+  while ((span_x / g.cell + 1) * (span_y / g.cell + 1) > kMaxCells) g.cell *= 2;
+  g.cols = static_cast<int>(span_x / g.cell + 1);
+  g.rows = static_cast<int>(span_y / g.cell + 1);
+  g.head.assign(static_cast<size_t>(g.cols) * g.rows, -1);
+  return g;
+}
+
 std::vector<ScoredBox> NonMaximumSuppression(std::vector<ScoredBox> boxes, float iou_threshold,
                                              int max_boxes) {
-  std::vector<ScoredBox> kept;
   // A NaN score has no place in the order (and would break the sort): such boxes are dropped.
   std::erase_if(boxes, [](const ScoredBox& b) { return std::isnan(b.score); });
-  if (boxes.empty() || max_boxes <= 0) return kept;
+  if (boxes.empty() || max_boxes <= 0) return {};
+  int min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  bool first = true;
+  for (const ScoredBox& b : boxes) {
+    if (b.box.empty()) continue;
+    min_x = first ? b.box.x : std::min(min_x, b.box.x);
+    min_y = first ? b.box.y : std::min(min_y, b.box.y);
+    max_x = first ? b.box.x : std::max(max_x, b.box.x);
+    max_y = first ? b.box.y : std::max(max_y, b.box.y);
+    first = false;
+  }
+  GreedyNms nms(iou_threshold, max_boxes, min_x, min_y, max_x, max_y);
   // Order: score descending, then input order (deterministic under ties). Sorting all boxes is
   // wasteful when max_boxes is reached early, so select and sort growing chunks from the front.
   std::vector<int> order(boxes.size());
@@ -142,25 +135,19 @@ std::vector<ScoredBox> NonMaximumSuppression(std::vector<ScoredBox> boxes, float
   const auto before = [&boxes](int a, int b) {
     return boxes[a].score > boxes[b].score || (boxes[a].score == boxes[b].score && a < b);
   };
-  KeptBoxIndex index(boxes, iou_threshold);
   size_t done = 0;
   size_t chunk = std::max<size_t>(1024, 4 * static_cast<size_t>(max_boxes));
-  while (done < order.size() && static_cast<int>(kept.size()) < max_boxes) {
-    const auto first = order.begin() + static_cast<std::ptrdiff_t>(done);
+  while (done < order.size() && !nms.full()) {
+    const auto first_it = order.begin() + static_cast<std::ptrdiff_t>(done);
     const size_t take = std::min(chunk, order.size() - done);
-    const auto last = first + static_cast<std::ptrdiff_t>(take);
-    if (last != order.end()) std::nth_element(first, last, order.end(), before);
-    std::sort(first, last, before);
-    for (auto it = first; it != last && static_cast<int>(kept.size()) < max_boxes; ++it) {
-      const ScoredBox& candidate = boxes[*it];
-      if (index.Suppressed(candidate.box)) continue;
-      index.Add(candidate.box);
-      kept.push_back(candidate);
-    }
+    const auto last = first_it + static_cast<std::ptrdiff_t>(take);
+    if (last != order.end()) std::nth_element(first_it, last, order.end(), before);
+    std::sort(first_it, last, before);
+    for (auto it = first_it; it != last && !nms.full(); ++it) nms.Offer(boxes[*it]);
     done += take;
     chunk *= 2;
   }
-  return kept;
+  return nms.TakeKept();
 }
 
 }  // namespace tod

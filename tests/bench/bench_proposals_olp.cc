@@ -9,8 +9,12 @@
 // Prints per map and region: windows visited, windows that ran the boundary-affinity walk,
 // windows with a non-zero score, all scorings that ran a walk, boxes out, median CPU and wall
 // milliseconds, and a digest of the returned boxes and scores (to check that a speed-up is exact).
+// With refine_limit > 0 (the approximation, see EdgeBoxParams) it also prints, against the exact
+// run: the recall of the planted objects (IoU >= 0.5 / 0.7) within the top-1000 boxes, and the
+// fraction of the exact top-1000 boxes that the approximate top-1000 still contains.
 //
-// Usage: bench_proposals_olp [repeats [map [region [threads]]]]   (map / region "all" = every one)
+// Usage: bench_proposals_olp [repeats [map [region [threads [refine_limit]]]]]
+//        (map / region "all" = every one)
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -86,13 +90,13 @@ cv::Mat1f BoundaryMap(const cv::Mat1i& labels, Strength strength) {
   return map;
 }
 
-cv::Mat1f WorstCaseMap(int width, int height) {
+cv::Mat1f WorstCaseMap(int width, int height, std::vector<tod::Box>* /*objects*/) {
   std::mt19937 rng(7);
   const cv::Mat1i labels = VoronoiLabels(width, height, 40, rng);
   return BoundaryMap(labels, [](int a, int b) { return 0.05f + 0.95f * PairHash(a, b, 0); });
 }
 
-cv::Mat1f RealisticMap(int width, int height) {
+cv::Mat1f RealisticMap(int width, int height, std::vector<tod::Box>* objects) {
   std::mt19937 rng(11);
   const cv::Mat1i labels = VoronoiLabels(width, height, 40, rng);
   cv::Mat1f map = BoundaryMap(labels, [](int a, int b) {
@@ -100,12 +104,15 @@ cv::Mat1f RealisticMap(int width, int height) {
     return u < 0.7f ? 0.01f + 0.08f * v : 0.1f + 0.5f * v * v;
   });
   // A few small obstacles per 10^5 px, with strong closed contours.
-  const int objects = std::max(2, width * height / 100000);
+  const int count = std::max(2, width * height / 100000);
   std::uniform_int_distribution<int> cx(20, width - 21), cy(20, height - 21), axis(4, 25);
   std::uniform_real_distribution<float> strong(0.8f, 1.f);
-  for (int i = 0; i < objects; ++i) {
-    cv::ellipse(map, cv::Point(cx(rng), cy(rng)), cv::Size(axis(rng), axis(rng)), 0.0, 0.0, 360.0,
-                cv::Scalar(strong(rng)), 1, cv::LINE_8);
+  for (int i = 0; i < count; ++i) {
+    const cv::Point centre(cx(rng), cy(rng));
+    const cv::Size axes(axis(rng), axis(rng));
+    cv::ellipse(map, centre, axes, 0.0, 0.0, 360.0, cv::Scalar(strong(rng)), 1, cv::LINE_8);
+    objects->push_back(tod::Box{centre.x - axes.width, centre.y - axes.height, 2 * axes.width + 1,
+                                2 * axes.height + 1});
   }
   return map;
 }
@@ -128,6 +135,39 @@ std::uint64_t Digest(const std::vector<tod::ScoredBox>& boxes) {
   return h;
 }
 
+// Fraction of the planted objects that one of the first `top` boxes covers with IoU >= iou.
+double Recall(const std::vector<tod::Box>& objects, const std::vector<tod::ScoredBox>& boxes,
+              size_t top, double iou) {
+  if (objects.empty()) return 0.0;
+  int found = 0;
+  for (const tod::Box& object : objects) {
+    for (size_t i = 0; i < std::min(top, boxes.size()); ++i) {
+      if (tod::BoxIoU(object, boxes[i].box) >= iou) {
+        ++found;
+        break;
+      }
+    }
+  }
+  return static_cast<double>(found) / static_cast<double>(objects.size());
+}
+
+// Fraction of the first `top` reference boxes that reappear (same box) among the first `top`.
+double SameTop(const std::vector<tod::ScoredBox>& reference,
+               const std::vector<tod::ScoredBox>& other, size_t top) {
+  const size_t n = std::min(top, reference.size());
+  if (n == 0) return 1.0;
+  int same = 0;
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < std::min(top, other.size()); ++j) {
+      if (other[j].box == reference[i].box) {
+        ++same;
+        break;
+      }
+    }
+  }
+  return static_cast<double>(same) / static_cast<double>(n);
+}
+
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
@@ -140,20 +180,23 @@ int main(int argc, char** argv) {
   const std::string only_map = argc > 2 ? argv[2] : "all";
   const std::string only_region = argc > 3 ? argv[3] : "all";
   const int threads = argc > 4 ? std::atoi(argv[4]) : 1;
+  const int refine_limit = argc > 5 ? std::atoi(argv[5]) : 0;
   struct Region {
     const char* name;
     int width, height;
     float ms_factor;  // the region's stride factor under MS (§4.2.6)
   };
   // LAF region sizes (§1.3).
-  const Region regions[] = {
-      {"R1", 1893, 615, 1.f}, {"R2", 949, 404, 0.75f}, {"R3", 433, 297, 0.5f}, {"R4", 341, 141, 0.25f}};
+  const Region regions[] = {{"R1", 1893, 615, 1.f},
+                            {"R2", 949, 404, 0.75f},
+                            {"R3", 433, 297, 0.5f},
+                            {"R4", 341, 141, 0.25f}};
   struct MapKind {
     const char* name;
-    cv::Mat1f (*make)(int, int);
+    cv::Mat1f (*make)(int, int, std::vector<tod::Box>*);
   };
   const MapKind maps[] = {{"real", RealisticMap}, {"worst", WorstCaseMap}};
-  std::printf("threads %d, %d repeats, medians\n", threads, repeats);
+  std::printf("threads %d, refine_limit %d, %d repeats, medians\n", threads, refine_limit, repeats);
   std::printf("%-6s %-6s %10s %6s %6s %10s %10s %8s %10s %6s %8s %8s %16s\n", "map", "region",
               "size", "factor", "edge%", "windows", "walks", "nonzero", "scorings", "boxes",
               "cpu_ms", "wall_ms", "digest");
@@ -162,13 +205,16 @@ int main(int argc, char** argv) {
     double cpu_total = 0.0, wall_total = 0.0;
     for (const Region& region : regions) {
       if (only_region != "all" && only_region != region.name) continue;
-      const cv::Mat1f map = tod::NormaliseToMax(kind.make(region.width, region.height));
+      std::vector<tod::Box> objects;
+      const cv::Mat1f map = tod::NormaliseToMax(kind.make(region.width, region.height, &objects));
       const double edge_percent = 100.0 * cv::countNonZero(map > 0.1f) / double(map.total());
       tod::EdgeBoxParams params;
       params.stride_factor = region.ms_factor;
       params.threads = threads;
+      params.refine_limit = refine_limit;
       tod::EdgeBoxStats stats;
       std::uint64_t digest = 0;
+      std::vector<tod::ScoredBox> last;
       std::vector<double> wall_ms, cpu_ms;
       for (int i = 0; i < repeats; ++i) {
         const auto t0 = std::chrono::steady_clock::now();
@@ -179,15 +225,28 @@ int main(int argc, char** argv) {
         wall_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
         cpu_ms.push_back(1000.0 * static_cast<double>(c1 - c0) / CLOCKS_PER_SEC);
         digest = Digest(boxes);
+        last = boxes;
       }
       // CPU time is what the budget is about on a shared machine (it sums over threads).
       cpu_total += Median(cpu_ms);
       wall_total += Median(wall_ms);
-      std::printf("%-6s %-6s %5dx%-4d %6.2f %6.2f %10lld %10lld %8lld %10lld %6lld %8.1f %8.1f %016llx\n",
-                  kind.name, region.name, region.width, region.height, region.ms_factor,
-                  edge_percent, stats.windows_visited, stats.windows_past_early_exit,
-                  stats.windows_nonzero, stats.scorings, stats.boxes_out, Median(cpu_ms),
-                  Median(wall_ms), static_cast<unsigned long long>(digest));
+      std::printf(
+          "%-6s %-6s %5dx%-4d %6.2f %6.2f %10lld %10lld %8lld %10lld %6lld %8.1f %8.1f %016llx\n",
+          kind.name, region.name, region.width, region.height, region.ms_factor, edge_percent,
+          stats.windows_visited, stats.windows_past_early_exit, stats.windows_nonzero,
+          stats.scorings, stats.boxes_out, Median(cpu_ms), Median(wall_ms),
+          static_cast<unsigned long long>(digest));
+      if (refine_limit > 0 && !objects.empty()) {
+        tod::EdgeBoxParams exact_params = params;
+        exact_params.refine_limit = 0;
+        const auto exact = tod::ScoreEdgeBoxes(map, exact_params);
+        std::printf(
+            "       %zu objects, top-1000 recall@0.5 %.2f -> %.2f, @0.7 %.2f -> %.2f, "
+            "exact top-1000 kept %.3f\n",
+            objects.size(), Recall(objects, exact, 1000, 0.5), Recall(objects, last, 1000, 0.5),
+            Recall(objects, exact, 1000, 0.7), Recall(objects, last, 1000, 0.7),
+            SameTop(exact, last, 1000));
+      }
     }
     std::printf("%-6s total: %.1f ms CPU, %.1f ms wall\n", kind.name, cpu_total, wall_total);
   }

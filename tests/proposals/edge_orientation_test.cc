@@ -52,3 +52,29 @@ TEST(EdgeOrientationTest, RangeAndDegenerateSizes) {
 
 }  // namespace
 }  // namespace tod
+
+namespace tod {
+namespace {
+
+TEST(EdgeOrientationTest, MaskedVariantEqualsFullOnEdgePixelsAndIsZeroElsewhere) {
+  cv::Mat1f map(30, 40, 0.f);
+  cv::circle(map, {20, 15}, 9, cv::Scalar(0.8f));
+  cv::line(map, {0, 3}, {39, 25}, cv::Scalar(0.05f));  // below the threshold
+  const cv::Mat1f full = ComputeEdgeOrientation(map);
+  const cv::Mat1f masked = ComputeEdgeOrientation(map, 0.1f);
+  int edges = 0;
+  for (int r = 0; r < map.rows; ++r) {
+    for (int c = 0; c < map.cols; ++c) {
+      if (map(r, c) > 0.1f) {
+        EXPECT_EQ(masked(r, c), full(r, c));
+        ++edges;
+      } else {
+        EXPECT_EQ(masked(r, c), 0.f);
+      }
+    }
+  }
+  EXPECT_GT(edges, 40);
+}
+
+}  // namespace
+}  // namespace tod

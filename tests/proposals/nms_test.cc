@@ -93,9 +93,9 @@ TEST(NmsTest, GridIndexEqualsPlainGreedyNmsOnWideRanges) {
   for (int i = 0; i < 600; ++i) {
     const Box base{pos(rng), pos(rng), size(rng), size(rng)};
     for (int k = 0; k < 4; ++k) {  // near-duplicates, the case NMS exists for
-      boxes.push_back({{base.x + jitter(rng), base.y + jitter(rng), base.w + jitter(rng),
-                        base.h + jitter(rng)},
-                       static_cast<float>(score(rng))});
+      boxes.push_back(
+          {{base.x + jitter(rng), base.y + jitter(rng), base.w + jitter(rng), base.h + jitter(rng)},
+           static_cast<float>(score(rng))});
     }
   }
   boxes.push_back({{1000000000, -1000000000, 50, 50}, 3.f});

@@ -1,5 +1,7 @@
 // Checks the optimised scorer (integral images, run indexes, queue walk, early stops) against a
 // direct transcription of ALGORITHM.md §4.2.4 on random boxes of a random contour map.
+#include "tests/proposals/reference_score.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,64 +17,7 @@
 namespace tod {
 namespace {
 
-// Score of the inclusive box [c0, c1] x [r0, r1] computed the slow, literal way: sums by pixel
-// loops, boundary groups by scanning the four sides, and the list walk with restarts.
-float ReferenceScore(const cv::Mat1f& map, const EdgeGroups& g, int r0, int c0, int r1, int c1,
-                     const EdgeBoxParams& p) {
-  const auto inside = [&](int s) {
-    return g.anchor_x[s] >= c0 && g.anchor_x[s] <= c1 && g.anchor_y[s] >= r0 && g.anchor_y[s] <= r1;
-  };
-  double v = 0.0;
-  for (int s = 1; s <= g.count(); ++s) {
-    if (inside(s)) v += g.magnitude[s];
-  }
-  const int bh = (r1 - r0) / 2, bw = (c1 - c0) / 2;
-  const int r0m = r0 + bh / 2, c0m = c0 + bw / 2;
-  for (int r = r0m; r <= r0m + bh; ++r) {
-    for (int c = c0m; c <= c0m + bw; ++c) {
-      if (map(r, c) > p.edge_min_mag) v -= map(r, c);
-    }
-  }
-  if (bw + bh == 0) return 0.f;
-  const float norm = std::pow(1.f / static_cast<float>(bw + bh), p.kappa);
-  if (v * norm < p.min_score) return 0.f;
-  std::vector<int> ids;
-  std::vector<float> weights;
-  const auto add_side_pixel = [&](int r, int c) {
-    const int s = g.ids(r, c);
-    if (s > 0 && std::find(ids.begin(), ids.end(), s) == ids.end()) {
-      ids.push_back(s);
-      weights.push_back(1.f);
-    }
-  };
-  for (int c = c0; c <= c1; ++c) add_side_pixel(r0, c), add_side_pixel(r1, c);
-  for (int r = r0; r <= r1; ++r) add_side_pixel(r, c0), add_side_pixel(r, c1);
-  for (int i = 0; i < static_cast<int>(ids.size()); ++i) {
-    const float w = weights[i];
-    const int s = ids[i];
-    for (int k = g.affinity_begin[s]; k < g.affinity_begin[s + 1]; ++k) {
-      const int t = g.affinity_target[k];
-      const float wt = w * g.affinity_value[k];
-      if (wt < 0.05f) continue;
-      const auto it = std::find(ids.begin(), ids.end(), t);
-      if (it != ids.end()) {
-        const int slot = static_cast<int>(it - ids.begin());
-        if (wt > weights[slot]) {
-          weights[slot] = wt;
-          i = std::min(i, slot - 1);
-        }
-      } else if (inside(t)) {
-        ids.push_back(t);
-        weights.push_back(wt);
-      }
-    }
-  }
-  for (size_t i = 0; i < ids.size(); ++i) {
-    if (inside(ids[i])) v -= weights[i] * g.magnitude[ids[i]];
-  }
-  const float score = static_cast<float>(v) * norm;
-  return score < p.min_score ? 0.f : score;
-}
+using testing::ReferenceScore;
 
 TEST(ReferenceScoreTest, OptimisedScorerMatchesLiteralDefinition) {
   std::mt19937 rng(11);
