@@ -11,9 +11,9 @@ namespace tod {
 
 enum class StatusCode {
   kOk = 0,
-  kInvalidArgument,   // bad input: undecodable image, malformed option, wrong shape
-  kNotFound,          // a file or field that must exist does not
-  kDataLoss,          // a file exists but is truncated or corrupt
+  kInvalidArgument,     // bad input: undecodable image, malformed option, wrong shape
+  kNotFound,            // a file or field that must exist does not
+  kDataLoss,            // a file exists but is truncated or corrupt
   kFailedPrecondition,  // e.g. model bundle of another format version
   kResourceExhausted,   // over a size limit
   kUnavailable,

@@ -15,8 +15,8 @@ struct Box {
   int w = 0;
   int h = 0;
 
-  int right() const { return x + w; }    // one past the last column
-  int bottom() const { return y + h; }   // one past the last row
+  int right() const { return x + w; }   // one past the last column
+  int bottom() const { return y + h; }  // one past the last row
   long long area() const { return static_cast<long long>(w) * h; }
   bool empty() const { return w <= 0 || h <= 0; }
   cv::Rect rect() const { return {x, y, w, h}; }
@@ -38,9 +38,9 @@ struct ScoredBox {
 
 // One annotated obstacle: its tight box and its mask restricted to that box (255 = obstacle).
 struct ObstacleInstance {
-  int id = 0;       // dataset instance id (LAF: class * 1000 + k)
-  Box box;          // tight box, full-image coordinates
-  cv::Mat1b mask;   // box.h x box.w
+  int id = 0;      // dataset instance id (LAF: class * 1000 + k)
+  Box box;         // tight box, full-image coordinates
+  cv::Mat1b mask;  // box.h x box.w
   long long pixel_count() const { return cv::countNonZero(mask); }
 };
 

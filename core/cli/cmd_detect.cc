@@ -2,7 +2,6 @@
 // (probability map, 255 = 1.0) and STEM_overlay.png.
 #include <filesystem>
 #include <iostream>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/base/atomic_file.h"
@@ -59,7 +58,8 @@ Runner AddDetectCommand(CLI::App& app) {
       const std::filesystem::path base = std::filesystem::path(args->out) / stem;
       Status st = WriteFileAtomically(base.string() + ".json",
                                       DetectionToJson(*detection, path).dump(2) + "\n");
-      if (st.ok()) st = WritePng(base.string() + "_prob.png", ProbabilityTo8Bit(detection->probability));
+      if (st.ok())
+        st = WritePng(base.string() + "_prob.png", ProbabilityTo8Bit(detection->probability));
       if (st.ok()) st = WritePng(base.string() + "_overlay.png", DrawOverlay(image, *detection));
       if (!st.ok()) return Fail(st.message());
       double total = 0;

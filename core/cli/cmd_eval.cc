@@ -14,12 +14,15 @@ Runner AddEvalCommand(CLI::App& app) {
     std::string model, json, plots;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("eval", "the paper's proposal and regression tables on a split");
+  CLI::App* cmd =
+      app.add_subcommand("eval", "the paper's proposal and regression tables on a split");
   cmd->add_option("--data", args->eval.data_root, "dataset root")->required();
   cmd->add_option("--model", args->model, "model bundle directory")->required();
   cmd->add_option("--split", args->eval.split, "split to evaluate");
-  cmd->add_option("--format", args->eval.format, "dataset format")->check(CLI::IsMember({"auto", "laf", "modd2"}));
-  cmd->add_option("--max-frames", args->eval.max_frames, "evaluate at most this many frames (0 = all)");
+  cmd->add_option("--format", args->eval.format, "dataset format")
+      ->check(CLI::IsMember({"auto", "laf", "modd2"}));
+  cmd->add_option("--max-frames", args->eval.max_frames,
+                  "evaluate at most this many frames (0 = all)");
   cmd->add_option("--threads", args->eval.threads, "worker threads (0 = all cores)");
   cmd->add_option("--json", args->json, "write the numbers as JSON to this file");
   cmd->add_option("--plots", args->plots, "draw the paper's curves as PNG into this directory");

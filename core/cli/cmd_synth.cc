@@ -13,7 +13,8 @@ Runner AddSynthCommand(CLI::App& app) {
     std::uint64_t seed = 1;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("synth", "write synthetic road scenes in the Lost and Found layout");
+  CLI::App* cmd =
+      app.add_subcommand("synth", "write synthetic road scenes in the Lost and Found layout");
   cmd->add_option("--out", args->out, "output dataset directory")->required();
   cmd->add_option("--train", args->train, "training frames")->check(CLI::NonNegativeNumber);
   cmd->add_option("--test", args->test, "test frames")->check(CLI::NonNegativeNumber);
@@ -24,13 +25,14 @@ Runner AddSynthCommand(CLI::App& app) {
     SynthParams params;
     params.width = args->width;
     params.height = args->height;
-    const Status st = WriteSynthDataset(args->out, params, args->train, args->test, args->seed,
-                                        [](int done, int total) {
-                                          if (done % 10 == 0 || done == total)
-                                            std::cerr << "synth: " << done << "/" << total << " frames\n";
-                                        });
+    const Status st = WriteSynthDataset(
+        args->out, params, args->train, args->test, args->seed, [](int done, int total) {
+          if (done % 10 == 0 || done == total)
+            std::cerr << "synth: " << done << "/" << total << " frames\n";
+        });
     if (!st.ok()) return Fail(st.message());
-    std::cout << "wrote " << args->train << " train + " << args->test << " test frames to " << args->out << "\n";
+    std::cout << "wrote " << args->train << " train + " << args->test << " test frames to "
+              << args->out << "\n";
     return 0;
   };
 }

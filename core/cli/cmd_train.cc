@@ -27,18 +27,24 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--regions", args->train.regions, "multilayer regions: auto (k-means) or laf2020")
       ->check(CLI::IsMember({"auto", "laf2020"}));
   cmd->add_option("--seed", args->train.seed, "random seed");
-  cmd->add_option("--format", args->train.format, "dataset format")->check(CLI::IsMember({"auto", "laf", "modd2"}));
+  cmd->add_option("--format", args->train.format, "dataset format")
+      ->check(CLI::IsMember({"auto", "laf", "modd2"}));
   cmd->add_option("--edge-source", args->train.edge_source, "base edge map")
       ->check(CLI::IsMember({"pixel_forest", "gradient", "sed"}));
-  cmd->add_option("--sed-model", args->train.sed_model, "OpenCV StructuredEdgeDetection model (.yml.gz)");
-  cmd->add_option("--max-frames", args->train.max_frames, "use at most this many training frames (0 = all)");
-  cmd->add_option("--classifier-frames", args->train.classifier_frames, "frames for the edge and occlusion classifiers");
-  cmd->add_option("--trees", args->trees, "trees per regressor (paper: 200)")->check(CLI::Range(1, 2000));
+  cmd->add_option("--sed-model", args->train.sed_model,
+                  "OpenCV StructuredEdgeDetection model (.yml.gz)");
+  cmd->add_option("--max-frames", args->train.max_frames,
+                  "use at most this many training frames (0 = all)");
+  cmd->add_option("--classifier-frames", args->train.classifier_frames,
+                  "frames for the edge and occlusion classifiers");
+  cmd->add_option("--trees", args->trees, "trees per regressor (paper: 200)")
+      ->check(CLI::Range(1, 2000));
   cmd->add_option("--threads", args->train.threads, "worker threads (0 = all cores)");
   cmd->add_flag("--no-size-filter", args->no_size_filter, "switch the box size filter off");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
-  cmd->add_option("--eval-frames", args->eval_frames, "evaluate on at most this many frames (0 = all)");
+  cmd->add_option("--eval-frames", args->eval_frames,
+                  "evaluate on at most this many frames (0 = all)");
   return [args] {
     TrainOptions options = args->train;
     if (!options.sed_model.empty() && options.edge_source != "sed") options.edge_source = "sed";

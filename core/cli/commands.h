@@ -2,9 +2,8 @@
 // and runs when selected. Exit codes: 0 ok, 1 failure (message on stderr), 2 usage.
 #pragma once
 
-#include <functional>
-
 #include <CLI/CLI.hpp>
+#include <functional>
 
 namespace tod::cli {
 

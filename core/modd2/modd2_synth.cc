@@ -97,7 +97,8 @@ Modd2Split Modd2SynthSplit(int sequences) {
   test_pool.insert(test_pool.end(), defaults.excluded.begin(), defaults.excluded.end());
   const int n = std::clamp(sequences, 1, static_cast<int>(Modd2SequenceNames().size()));
   int train_count = 1;
-  if (n >= 2) train_count = std::clamp(static_cast<int>(std::lround(kModd2TrainFraction * n)), 1, n - 1);
+  if (n >= 2)
+    train_count = std::clamp(static_cast<int>(std::lround(kModd2TrainFraction * n)), 1, n - 1);
   train_count = std::min<int>(train_count, static_cast<int>(defaults.train.size()));
   const int test_count = std::min<int>(n - train_count, static_cast<int>(test_pool.size()));
   Modd2Split split;

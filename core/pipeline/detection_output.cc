@@ -1,7 +1,6 @@
 #include "core/pipeline/detection_output.h"
 
 #include <cstdio>
-
 #include <opencv2/imgproc.hpp>
 
 namespace tod {
@@ -13,12 +12,21 @@ nlohmann::json DetectionToJson(const Detection& d, const std::string& image_name
   j["height"] = d.height;
   j["proposals"] = nlohmann::json::array();
   for (const Proposal& p : d.proposals)
-    j["proposals"].push_back({{"x", p.box.x}, {"y", p.box.y}, {"w", p.box.w}, {"h", p.box.h},
-                              {"score", p.fused}, {"ordr", p.ordr}, {"obdr", p.obdr}});
+    j["proposals"].push_back({{"x", p.box.x},
+                              {"y", p.box.y},
+                              {"w", p.box.w},
+                              {"h", p.box.h},
+                              {"score", p.fused},
+                              {"ordr", p.ordr},
+                              {"obdr", p.obdr}});
   j["obstacles"] = nlohmann::json::array();
   for (const DetectedObstacle& o : d.obstacles)
-    j["obstacles"].push_back({{"x", o.box.x}, {"y", o.box.y}, {"w", o.box.w}, {"h", o.box.h},
-                              {"area", o.area}, {"peak", o.peak_probability},
+    j["obstacles"].push_back({{"x", o.box.x},
+                              {"y", o.box.y},
+                              {"w", o.box.w},
+                              {"h", o.box.h},
+                              {"area", o.area},
+                              {"peak", o.peak_probability},
                               {"mean", o.mean_probability}});
   nlohmann::json timing = nlohmann::json::object();
   double total = 0;
@@ -51,8 +59,7 @@ cv::Mat3b DrawOverlay(const cv::Mat3b& bgr, const Detection& d, int top_proposal
       }
   }
   const int n = std::min<int>(top_proposals, static_cast<int>(d.proposals.size()));
-  for (int i = n - 1; i >= 0; --i)
-    cv::rectangle(out, d.proposals[i].box.rect(), {255, 255, 0}, 1);
+  for (int i = n - 1; i >= 0; --i) cv::rectangle(out, d.proposals[i].box.rect(), {255, 255, 0}, 1);
   const double scale = std::max(0.4, bgr.cols / 2048.0);
   for (const DetectedObstacle& o : d.obstacles) {
     cv::rectangle(out, o.box.rect(), {0, 255, 255}, std::max(1, static_cast<int>(2 * scale)));

@@ -3,10 +3,9 @@
 // service so every front end draws and encodes the same way.
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "core/pipeline/detector.h"
 

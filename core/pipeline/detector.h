@@ -3,11 +3,10 @@
 #pragma once
 
 #include <memory>
-#include <string>
-#include <vector>
-
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <string>
+#include <vector>
 
 #include "core/base/stage_timer.h"
 #include "core/base/status.h"
@@ -16,8 +15,8 @@
 namespace tod {
 
 struct DetectOptions {
-  int max_proposals = 100;           // proposals returned (the map always uses all of them)
-  float obstacle_threshold = 0.5f;   // obstacle mask = P > threshold
+  int max_proposals = 100;          // proposals returned (the map always uses all of them)
+  float obstacle_threshold = 0.5f;  // obstacle mask = P > threshold
   bool want_probability_map = true;
 };
 
@@ -40,18 +39,18 @@ struct Detection {
   int height = 0;
   std::vector<Proposal> proposals;  // descending fused score, at most max_proposals
   std::vector<DetectedObstacle> obstacles;
-  cv::Mat1f probability;            // image size, [0,1]; empty unless requested
-  StageTimes timings;               // per stage, in pipeline order, milliseconds
+  cv::Mat1f probability;  // image size, [0,1]; empty unless requested
+  StageTimes timings;     // per stage, in pipeline order, milliseconds
 };
 
 struct ModelInfo {
-  std::string name;           // bundle directory name
-  std::string version;        // bundle's own version string
+  std::string name;     // bundle directory name
+  std::string version;  // bundle's own version string
   int format_version = 0;
-  std::string created;        // ISO 8601
-  std::string trained_on;     // dataset description
-  std::string edge_source;    // "pixel_forest", "gradient", "sed"
-  nlohmann::json manifest;    // the whole manifest
+  std::string created;      // ISO 8601
+  std::string trained_on;   // dataset description
+  std::string edge_source;  // "pixel_forest", "gradient", "sed"
+  nlohmann::json manifest;  // the whole manifest
 };
 
 class Detector {

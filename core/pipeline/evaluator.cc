@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <mutex>
-#include <sstream>
-
 #include <opencv2/ximgproc/edgeboxes.hpp>
+#include <sstream>
 
 #include "core/metrics/instance_recall.h"
 #include "core/pipeline/dataset_factory.h"
@@ -75,7 +74,9 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   if (!dataset.ok()) return dataset.status();
   const int total = static_cast<int>((*dataset)->size());
   const int n = options.max_frames > 0 ? std::min(total, options.max_frames) : total;
-  if (n == 0) return Status::InvalidArgument(options.data_root + ": the " + options.split + " split is empty");
+  if (n == 0)
+    return Status::InvalidArgument(options.data_root + ": the " + options.split +
+                                   " split is empty");
 
   std::map<std::string, RecallAccumulator> recall;
   for (const auto& v : ProposalVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
@@ -118,24 +119,30 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     for (std::size_t j = 0; j < bp.boxes.size(); ++j)
       if (bp.layer[j] == 0) oaocc1.push_back(bp.boxes[j].box);
     const std::vector<Box> bp_boxes = BoxesOf(bp.boxes);
-    const RegressedProposals bp_reg = RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(bp), &timer);
+    const RegressedProposals bp_reg =
+        RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(bp), &timer);
     const std::vector<float> fused = FuseScores(bp_reg.ordr, bp_reg.obdr, bundle.params.fusion);
     std::vector<ScoredBox> bp_fusion(fused.size()), bp_ordr(fused.size());
     for (std::size_t j = 0; j < fused.size(); ++j) {
       bp_fusion[j] = {bp_reg.proposals.boxes[j].box, fused[j]};
       bp_ordr[j] = {bp_reg.proposals.boxes[j].box, bp_reg.ordr[j]};
     }
-    const cv::Mat1f map_fusion = AccumulateProbabilityMap(bp_fusion, s.image.size(), bundle.params.probability_map);
+    const cv::Mat1f map_fusion =
+        AccumulateProbabilityMap(bp_fusion, s.image.size(), bundle.params.probability_map);
     timer.Mark("probability_map");
 
     ProposalSet op = ProposeBoxes(oaocc, geo.regions, bundle.params.boxes,
                                   {layers, false, bundle.params.size_filter}, geo.size_filter);
     const std::vector<Box> op_boxes = BoxesOf(op.boxes);
-    const RegressedProposals op_reg = RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(op));
+    const RegressedProposals op_reg =
+        RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(op));
     std::vector<ScoredBox> op_ordr(op_reg.ordr.size());
-    for (std::size_t j = 0; j < op_ordr.size(); ++j) op_ordr[j] = {op_reg.proposals.boxes[j].box, op_reg.ordr[j]};
-    const cv::Mat1f map_bp_ordr = AccumulateProbabilityMap(bp_ordr, s.image.size(), bundle.params.probability_map);
-    const cv::Mat1f map_op_ordr = AccumulateProbabilityMap(op_ordr, s.image.size(), bundle.params.probability_map);
+    for (std::size_t j = 0; j < op_ordr.size(); ++j)
+      op_ordr[j] = {op_reg.proposals.boxes[j].box, op_reg.ordr[j]};
+    const cv::Mat1f map_bp_ordr =
+        AccumulateProbabilityMap(bp_ordr, s.image.size(), bundle.params.probability_map);
+    const cv::Mat1f map_op_ordr =
+        AccumulateProbabilityMap(op_ordr, s.image.size(), bundle.params.probability_map);
     const float min_score = bundle.params.probability_map.min_score;
 
     std::vector<Box> gt;
@@ -174,7 +181,8 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     for (double fpr : TableFprs()) report.tpr_at_fpr[v][fpr] = TprAtFpr(report.roc[v], fpr);
   }
   stage_order.push_back("total");
-  for (const auto& stage : stage_order) report.stage_median_ms.emplace_back(stage, Median(stage_ms[stage]));
+  for (const auto& stage : stage_order)
+    report.stage_median_ms.emplace_back(stage, Median(stage_ms[stage]));
   return report;
 }
 
@@ -205,12 +213,14 @@ std::string FormatEvalTables(const EvalReport& r) {
   o << "frames " << r.frames << ", obstacle instances " << r.instances << "\n\n";
   o << "Average recall (proposals)\n";
   char line[256];
-  std::snprintf(line, sizeof line, "%-16s %7s %7s %7s %7s %7s\n", "variant", "200", "400", "600", "800", "1000");
+  std::snprintf(line, sizeof line, "%-16s %7s %7s %7s %7s %7s\n", "variant", "200", "400", "600",
+                "800", "1000");
   o << line;
   auto ar_row = [&](const std::string& name, const VariantCurves& c) {
     std::snprintf(line, sizeof line, "%-16s", name.c_str());
     o << line;
-    for (int n : kTableN) o << " " << std::string(7 - Fixed(c.ar_table.at(n)).size(), ' ') << Fixed(c.ar_table.at(n));
+    for (int n : kTableN)
+      o << " " << std::string(7 - Fixed(c.ar_table.at(n)).size(), ' ') << Fixed(c.ar_table.at(n));
     o << "\n";
   };
   for (const auto& v : ProposalVariants()) ar_row(v, r.proposals.at(v));

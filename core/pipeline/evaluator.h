@@ -6,10 +6,9 @@
 
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "core/metrics/pixel_roc.h"
 #include "core/pipeline/model_bundle.h"

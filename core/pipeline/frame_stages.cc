@@ -105,7 +105,8 @@ cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& 
     const BoxFeatureExtractor extractor(frame_colour, RegionEdgeMap(oaocc, regions, k),
                                         cv::Point(region.x, region.y), image.size());
     const cv::Mat1f region_rows = extractor.ComputeAll(boxes);
-    for (std::size_t j = 0; j < members.size(); ++j) region_rows.row(static_cast<int>(j)).copyTo(rows.row(members[j]));
+    for (std::size_t j = 0; j < members.size(); ++j)
+      region_rows.row(static_cast<int>(j)).copyTo(rows.row(members[j]));
   }
   return rows;
 }

@@ -2,9 +2,8 @@
 // edges on R1 (§2-3), multistride proposals over the K regions (§4), the 20 features (§5).
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/base/stage_timer.h"
 #include "core/edges/edge_source.h"
@@ -17,12 +16,12 @@
 namespace tod {
 
 struct OcclusionEdges {
-  Box r1;                   // full-image box of the crop
-  cv::Mat3b crop;           // image restricted to R1 (a view into the frame)
-  cv::Mat1f base_edge;      // E
-  cv::Mat1f enhanced;       // Ê = n(p) E(p)
+  Box r1;               // full-image box of the crop
+  cv::Mat3b crop;       // image restricted to R1 (a view into the frame)
+  cv::Mat1f base_edge;  // E
+  cv::Mat1f enhanced;   // Ê = n(p) E(p)
   Superpixels superpixels;
-  cv::Mat1f occlusion;      // occlusion edge map on the crop
+  cv::Mat1f occlusion;  // occlusion edge map on the crop
 };
 
 // enhance = false gives the plain (non obstacle-aware) variant used by the OLP baseline.
@@ -37,7 +36,7 @@ OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerReg
 cv::Mat1f RegionEdgeMap(const OcclusionEdges& oaocc, const MultilayerRegions& regions, int k);
 
 struct ProposalOptions {
-  int layers_used = 4;    // @k: boxes from R_1 .. R_k
+  int layers_used = 4;  // @k: boxes from R_1 .. R_k
   bool multistride = true;
   bool size_filter = true;
 };

@@ -89,7 +89,8 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   Status st;
   if (bundle.edge_kind == "pixel_forest") {
     const auto* classifier = dynamic_cast<const PixelEdgeClassifier*>(bundle.edges.get());
-    if (classifier == nullptr) return Status::InvalidArgument("pixel_forest bundle without classifier");
+    if (classifier == nullptr)
+      return Status::InvalidArgument("pixel_forest bundle without classifier");
     st = add(kEdgesFile, Serialise(*classifier));
     if (!st.ok()) return st;
   } else if (bundle.edge_kind == "sed") {
@@ -116,8 +117,8 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   if ((st = WriteFile(tmp / kManifest, manifest.dump(2) + "\n")); !st.ok()) return st;
 
   // Swap in: move an existing bundle aside, rename the new one, then delete the old one.
-  const fs::path old = target.parent_path() / (target.filename().string() + "." +
-                                                std::to_string(::getpid()) + ".old");
+  const fs::path old = target.parent_path() /
+                       (target.filename().string() + "." + std::to_string(::getpid()) + ".old");
   const bool had_old = fs::exists(target, ec);
   if (had_old) {
     fs::remove_all(old, ec);
@@ -158,10 +159,12 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
     bundle.created = manifest.value("created", "");
     bundle.edge_kind = manifest.at("edge_source").get<std::string>();
     auto params = PipelineParamsFromJson(manifest.at("params"));
-    if (!params.ok()) return Status::InvalidArgument(manifest_path + ": " + params.status().message());
+    if (!params.ok())
+      return Status::InvalidArgument(manifest_path + ": " + params.status().message());
     bundle.params = *params;
     auto regions = MultilayerRegions::FromJson(manifest.at("regions"));
-    if (!regions.ok()) return Status::InvalidArgument(manifest_path + ": " + regions.status().message());
+    if (!regions.ok())
+      return Status::InvalidArgument(manifest_path + ": " + regions.status().message());
     bundle.regions = *regions;
     bundle.size_filter = SizeFilter::FromJson(manifest.at("size_filter"));
     bundle.training = manifest.value("training", nlohmann::json());
@@ -224,7 +227,8 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
     if (!sed.ok()) return sed.status();
     bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
   } else {
-    return Status::InvalidArgument(manifest_path + ": unknown edge_source '" + bundle.edge_kind + "'");
+    return Status::InvalidArgument(manifest_path + ": unknown edge_source '" + bundle.edge_kind +
+                                   "'");
   }
   if (bundle.ordr.num_features() != 20 || bundle.obdr.num_features() != 20)
     return Status::DataLoss((root / kOrdrFile).string() + ": regressors must take 20 features");

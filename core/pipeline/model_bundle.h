@@ -5,9 +5,8 @@
 #pragma once
 
 #include <memory>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "core/base/status.h"
 #include "core/edges/edge_source.h"
@@ -27,7 +26,7 @@ struct ModelBundle {
   SizeFilter size_filter;
   std::string edge_kind = "pixel_forest";  // "pixel_forest", "gradient", "sed"
   std::shared_ptr<const EdgeSource> edges;
-  std::string sed_model_file;               // for "sed": file name inside the bundle
+  std::string sed_model_file;  // for "sed": file name inside the bundle
   OcclusionClassifier occlusion;
   RandomForest ordr;
   RandomForest obdr;

@@ -103,7 +103,8 @@ std::vector<int> MultilayerRegions::RangeLimits() const {
   for (const Box& r : layers) limits.push_back(r.bottom() - 1);
   if (!layers.empty()) limits.push_back(layers.back().y);
   // Enforce strictly decreasing limits so every range is well defined even for odd regions.
-  for (std::size_t i = 1; i < limits.size(); ++i) limits[i] = std::min(limits[i], limits[i - 1] - 1);
+  for (std::size_t i = 1; i < limits.size(); ++i)
+    limits[i] = std::min(limits[i], limits[i - 1] - 1);
   return limits;
 }
 
@@ -147,7 +148,8 @@ Result<MultilayerRegions> MultilayerRegions::FromJson(const nlohmann::json& j) {
     for (std::size_t k = 0; k < out.layers.size(); ++k) {
       const Box& r = out.layers[k];
       if (r.empty() || ClipToImage(r, out.image_width, out.image_height) != r)
-        return Status::InvalidArgument("region R" + std::to_string(k + 1) + " is empty or outside the image");
+        return Status::InvalidArgument("region R" + std::to_string(k + 1) +
+                                       " is empty or outside the image");
     }
     return out;
   } catch (const nlohmann::json::exception& e) {
@@ -167,7 +169,8 @@ Result<MultilayerRegions> DeriveMultilayerRegions(const std::vector<ObstacleFoot
   // Features: bottom distance to the image's last row and pixel area, min-max normalised.
   std::vector<Point2> pts;
   for (const auto& o : obstacles)
-    pts.push_back({static_cast<double>(image_height - o.box.bottom()), static_cast<double>(o.pixels)});
+    pts.push_back(
+        {static_cast<double>(image_height - o.box.bottom()), static_cast<double>(o.pixels)});
   Point2 lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
   Point2 hi{std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()};
   for (const auto& p : pts) {
@@ -225,7 +228,8 @@ MultilayerRegions Laf2020Regions() {
   MultilayerRegions out;
   out.image_width = 2048;
   out.image_height = 1024;
-  out.layers = {{0, 225, 1893, 615}, {582, 308, 949, 404}, {841, 356, 433, 297}, {904, 373, 341, 141}};
+  out.layers = {
+      {0, 225, 1893, 615}, {582, 308, 949, 404}, {841, 356, 433, 297}, {904, 373, 341, 141}};
   return out;
 }
 

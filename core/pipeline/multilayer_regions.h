@@ -4,10 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "core/base/status.h"
 #include "core/base/types.h"
@@ -15,8 +14,8 @@
 namespace tod {
 
 struct RegionParams {
-  int num_layers = 4;            // K
-  int restarts = 10;             // k-means++ restarts, lowest SSE kept
+  int num_layers = 4;  // K
+  int restarts = 10;   // k-means++ restarts, lowest SSE kept
   int max_iterations = 300;
   double margin_fraction = 0.1;  // grown on each side, as a fraction of the box size (§1.4)
   std::uint64_t seed = 1;
@@ -24,8 +23,8 @@ struct RegionParams {
 
 // One training obstacle as k-means sees it.
 struct ObstacleFootprint {
-  Box box;                 // tight box
-  long long pixels = 0;    // mask pixel count
+  Box box;               // tight box
+  long long pixels = 0;  // mask pixel count
 };
 
 struct MultilayerRegions {

@@ -35,7 +35,8 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   const std::vector<int> gated = GatedByOrdr(out.ordr, bundle.params.fusion);
   const std::vector<float> gated_obdr = bundle.obdr.PredictBatch(features, gated);
   out.obdr.assign(out.ordr.size(), 0.f);
-  for (std::size_t r = 0; r < gated.size() && r < gated_obdr.size(); ++r) out.obdr[gated[r]] = gated_obdr[r];
+  for (std::size_t r = 0; r < gated.size() && r < gated_obdr.size(); ++r)
+    out.obdr[gated[r]] = gated_obdr[r];
   if (timer) timer->Mark("regression");
   out.proposals = std::move(proposals);
   return out;
@@ -49,26 +50,24 @@ ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
   info_.created = bundle_.created;
   info_.trained_on = bundle_.training.value("data", std::string());
   info_.edge_source = bundle_.edge_kind;
-  info_.manifest = {{"version", bundle_.version},
-                    {"created", bundle_.created},
-                    {"edge_source", bundle_.edge_kind},
-                    {"params", ToJson(bundle_.params)},
-                    {"regions", bundle_.regions.ToJson()},
-                    {"size_filter", bundle_.size_filter.ToJson()},
-                    {"training", bundle_.training},
-                    {"eval", bundle_.eval}};
+  info_.manifest = {
+      {"version", bundle_.version},          {"created", bundle_.created},
+      {"edge_source", bundle_.edge_kind},    {"params", ToJson(bundle_.params)},
+      {"regions", bundle_.regions.ToJson()}, {"size_filter", bundle_.size_filter.ToJson()},
+      {"training", bundle_.training},        {"eval", bundle_.eval}};
 }
 
-Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOptions& options) const {
+Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
+                                           const DetectOptions& options) const {
   if (bgr.empty()) return Status::InvalidArgument("empty image");
   if (bgr.cols < 16 || bgr.rows < 16)
     return Status::InvalidArgument("image too small: " + std::to_string(bgr.cols) + "x" +
                                    std::to_string(bgr.rows) + " (at least 16x16)");
   StageTimer timer;
   const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
-  const OcclusionEdges oaocc = ComputeOcclusionEdges(
-      bgr, geometry.regions, *bundle_.edges, &bundle_.occlusion, bundle_.params.superpixels,
-      /*enhance=*/true, &timer);
+  const OcclusionEdges oaocc = ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges,
+                                                     &bundle_.occlusion, bundle_.params.superpixels,
+                                                     /*enhance=*/true, &timer);
   ProposalOptions proposal_options;
   proposal_options.layers_used = geometry.regions.num_layers();
   proposal_options.multistride = bundle_.params.multistride;
@@ -78,7 +77,8 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   timer.Mark("proposals");
   RegressedProposals regressed =
       RegressProposals(bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer);
-  const std::vector<float> fused = FuseScores(regressed.ordr, regressed.obdr, bundle_.params.fusion);
+  const std::vector<float> fused =
+      FuseScores(regressed.ordr, regressed.obdr, bundle_.params.fusion);
 
   std::vector<ScoredBox> scored(fused.size());
   for (std::size_t i = 0; i < fused.size(); ++i)

@@ -105,8 +105,8 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
   } catch (const nlohmann::json::exception& e) {
     return Status::InvalidArgument(std::string("parameters: ") + e.what());
   }
-  if (p.regions.num_layers < 1 || p.superpixels.k < 1 || p.boxes.alpha <= 0 ||
-      p.boxes.alpha >= 1 || p.boxes.min_box_area <= 0)
+  if (p.regions.num_layers < 1 || p.superpixels.k < 1 || p.boxes.alpha <= 0 || p.boxes.alpha >= 1 ||
+      p.boxes.min_box_area <= 0)
     return Status::InvalidArgument("parameters out of range (num_layers, k, alpha, min_box_area)");
   return p;
 }

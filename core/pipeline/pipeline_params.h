@@ -19,8 +19,8 @@ struct PipelineParams {
   GradientEdgeParams gradient_edges;
   StickySuperpixelParams superpixels;
   EdgeBoxParams boxes;
-  bool multistride = true;     // MS: stride factor (K - k + 1) / K in region k (§4.2.6)
-  bool size_filter = true;     // §4.3, switchable
+  bool multistride = true;  // MS: stride factor (K - k + 1) / K in region k (§4.2.6)
+  bool size_filter = true;  // §4.3, switchable
   FusionParams fusion;
   ProbabilityMapParams probability_map;
 };

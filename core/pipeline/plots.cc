@@ -2,19 +2,19 @@
 
 #include <cstdio>
 #include <filesystem>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace tod {
 namespace {
 
-const cv::Scalar kPalette[] = {{31, 119, 180}, {14, 127, 255}, {44, 160, 44},  {40, 39, 214},
-                               {189, 103, 148}, {75, 86, 140}, {194, 119, 227}, {127, 127, 127}};
+const cv::Scalar kPalette[] = {{31, 119, 180},  {14, 127, 255}, {44, 160, 44},   {40, 39, 214},
+                               {189, 103, 148}, {75, 86, 140},  {194, 119, 227}, {127, 127, 127}};
 
 std::string Tick(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, v == static_cast<long long>(v) && std::abs(v) >= 1 ? "%.0f" : "%.2f", v);
+  std::snprintf(buf, sizeof buf,
+                v == static_cast<long long>(v) && std::abs(v) >= 1 ? "%.0f" : "%.2f", v);
   return buf;
 }
 
@@ -36,17 +36,21 @@ cv::Mat3b RenderLineChart(const PlotSpec& spec, const std::vector<PlotSeries>& s
     const double y = spec.y_min + (spec.y_max - spec.y_min) * i / 5.0;
     cv::line(img, px(x, spec.y_min), px(x, spec.y_max), {230, 230, 230}, 1);
     cv::line(img, px(spec.x_min, y), px(spec.x_max, y), {230, 230, 230}, 1);
-    cv::putText(img, Tick(x), px(x, spec.y_min) + cv::Point(-14, 22), font, 0.45, {0, 0, 0}, 1, cv::LINE_AA);
-    cv::putText(img, Tick(y), px(spec.x_min, y) + cv::Point(-50, 5), font, 0.45, {0, 0, 0}, 1, cv::LINE_AA);
+    cv::putText(img, Tick(x), px(x, spec.y_min) + cv::Point(-14, 22), font, 0.45, {0, 0, 0}, 1,
+                cv::LINE_AA);
+    cv::putText(img, Tick(y), px(spec.x_min, y) + cv::Point(-50, 5), font, 0.45, {0, 0, 0}, 1,
+                cv::LINE_AA);
   }
   cv::rectangle(img, area, {0, 0, 0}, 1);
   cv::putText(img, spec.title, {left, 30}, font, 0.7, {0, 0, 0}, 1, cv::LINE_AA);
-  cv::putText(img, spec.x_label, {area.x + area.width / 2 - 60, height - 20}, font, 0.55, {0, 0, 0}, 1, cv::LINE_AA);
+  cv::putText(img, spec.x_label, {area.x + area.width / 2 - 60, height - 20}, font, 0.55, {0, 0, 0},
+              1, cv::LINE_AA);
   cv::Mat3b ylabel(30, 300, cv::Vec3b(255, 255, 255));
   cv::putText(ylabel, spec.y_label, {5, 20}, font, 0.55, {0, 0, 0}, 1, cv::LINE_AA);
   cv::Mat3b rotated;
   cv::rotate(ylabel, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
-  rotated.copyTo(img(cv::Rect(5, top + std::max(0, (area.height - rotated.rows) / 2), rotated.cols, rotated.rows)));
+  rotated.copyTo(img(cv::Rect(5, top + std::max(0, (area.height - rotated.rows) / 2), rotated.cols,
+                              rotated.rows)));
   for (std::size_t s = 0; s < series.size(); ++s) {
     const cv::Scalar colour = kPalette[s % (sizeof kPalette / sizeof kPalette[0])];
     std::vector<cv::Point> pts;
@@ -56,7 +60,8 @@ cv::Mat3b RenderLineChart(const PlotSpec& spec, const std::vector<PlotSeries>& s
     if (pts.size() >= 2) cv::polylines(img, pts, false, colour, 2, cv::LINE_AA);
     const cv::Point legend(area.x + area.width - 230, area.y + 20 + 22 * static_cast<int>(s));
     cv::line(img, legend, legend + cv::Point(30, 0), colour, 3);
-    cv::putText(img, series[s].label, legend + cv::Point(38, 5), font, 0.5, {0, 0, 0}, 1, cv::LINE_AA);
+    cv::putText(img, series[s].label, legend + cv::Point(38, 5), font, 0.5, {0, 0, 0}, 1,
+                cv::LINE_AA);
   }
   return img;
 }
@@ -65,7 +70,9 @@ Status WriteEvalPlots(const EvalReport& report, const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return Status::Internal("cannot create " + dir + ": " + ec.message());
-  auto to_double = [](const std::vector<int>& v) { return std::vector<double>(v.begin(), v.end()); };
+  auto to_double = [](const std::vector<int>& v) {
+    return std::vector<double>(v.begin(), v.end());
+  };
   std::vector<PlotSeries> at07, at1000, ar, roc;
   auto add = [&](const std::string& name, const VariantCurves& c) {
     at07.push_back({name, to_double(c.n_grid), c.recall_at_07});
@@ -78,13 +85,18 @@ Status WriteEvalPlots(const EvalReport& report, const std::string& dir) {
     roc.push_back({v, report.roc.at(v).fpr, report.roc.at(v).tpr});
   }
   const std::vector<std::pair<std::string, cv::Mat3b>> charts = {
-      {"recall_vs_proposals.png",
-       RenderLineChart({"Recall vs proposals (IoU 0.7)", "number of proposals", "recall", 0, 1000, 0, 1}, at07)},
+      {"recall_vs_proposals.png", RenderLineChart({"Recall vs proposals (IoU 0.7)",
+                                                   "number of proposals", "recall", 0, 1000, 0, 1},
+                                                  at07)},
       {"recall_vs_iou.png",
-       RenderLineChart({"Recall vs IoU (1000 proposals)", "IoU threshold", "recall", 0.5, 1, 0, 1}, at1000)},
-      {"ar_vs_proposals.png",
-       RenderLineChart({"Average recall vs proposals", "number of proposals", "average recall", 0, 1000, 0, 1}, ar)},
-      {"pixel_roc.png", RenderLineChart({"Pixel ROC", "false positive rate", "true positive rate", 0, 0.05, 0, 1}, roc)}};
+       RenderLineChart({"Recall vs IoU (1000 proposals)", "IoU threshold", "recall", 0.5, 1, 0, 1},
+                       at1000)},
+      {"ar_vs_proposals.png", RenderLineChart({"Average recall vs proposals", "number of proposals",
+                                               "average recall", 0, 1000, 0, 1},
+                                              ar)},
+      {"pixel_roc.png",
+       RenderLineChart({"Pixel ROC", "false positive rate", "true positive rate", 0, 0.05, 0, 1},
+                       roc)}};
   for (const auto& [name, img] : charts) {
     const std::string path = (std::filesystem::path(dir) / name).string();
     if (!cv::imwrite(path, img)) return Status::Internal("cannot write " + path);

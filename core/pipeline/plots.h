@@ -2,10 +2,9 @@
 // recall vs proposals at IoU 0.7, recall vs IoU at 1000, AR vs proposals, pixel ROC.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/base/status.h"
 #include "core/pipeline/evaluator.h"

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <numeric>
-
 #include <opencv2/imgproc.hpp>
 
 #include "core/proposals/edge_box_scorer.h"
@@ -92,8 +91,9 @@ std::vector<ObstacleComponent> ThresholdObstacles(const cv::Mat1f& probability, 
     c.area = stats.at<int>(l, cv::CC_STAT_AREA);
     c.mean = c.area > 0 ? static_cast<float>(sums[l - 1] / c.area) : 0.f;
   }
-  std::stable_sort(out.begin(), out.end(),
-                   [](const ObstacleComponent& a, const ObstacleComponent& b) { return a.peak > b.peak; });
+  std::stable_sort(
+      out.begin(), out.end(),
+      [](const ObstacleComponent& a, const ObstacleComponent& b) { return a.peak > b.peak; });
   return out;
 }
 

@@ -1,16 +1,15 @@
 // Fusion of the two regressors and the obstacle-occupied probability map (ALGORITHM.md §6.5, §7).
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/base/types.h"
 
 namespace tod {
 
 struct FusionParams {
-  float beta1 = 0.3f;     // weight of OBDR
+  float beta1 = 0.3f;       // weight of OBDR
   float keep_ratio = 0.5f;  // tau_beta: the top half by ORDR passes the gate
 };
 
@@ -23,7 +22,7 @@ std::vector<float> FuseScores(const std::vector<float>& ordr, const std::vector<
                               const FusionParams& params = {});
 
 struct ProbabilityMapParams {
-  float min_score = 0.25f;   // boxes at or below are dropped (authors' code)
+  float min_score = 0.25f;  // boxes at or below are dropped (authors' code)
   float nms_iou = 0.7f;
   int max_boxes = 1000;
   float top_fraction = 0.5f;  // the top half of the kept boxes is accumulated

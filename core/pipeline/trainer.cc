@@ -25,7 +25,8 @@ std::vector<int> SpreadIndices(int n, int count) {
     for (int i = 0; i < n; ++i) out.push_back(i);
     return out;
   }
-  for (int j = 0; j < count; ++j) out.push_back(static_cast<int>((static_cast<long long>(j) * n) / count));
+  for (int j = 0; j < count; ++j)
+    out.push_back(static_cast<int>((static_cast<long long>(j) * n) / count));
   return out;
 }
 
@@ -69,7 +70,9 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   if (!dataset.ok()) return dataset.status();
   const int total = static_cast<int>((*dataset)->size());
   const int n = options.max_frames > 0 ? std::min(total, options.max_frames) : total;
-  if (n == 0) return Status::InvalidArgument(options.data_root + ": the " + options.split + " split is empty");
+  if (n == 0)
+    return Status::InvalidArgument(options.data_root + ": the " + options.split +
+                                   " split is empty");
   const std::vector<int> frame_ids = SpreadIndices(total, n);
 
   // 1. Read the split (kept in memory: every later step visits every frame).
@@ -78,15 +81,18 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   std::vector<Status> errors(n);
   ParallelFor(n, options.threads, [&](int i) {
     auto s = (*dataset)->Load(frame_ids[i]);
-    if (s.ok()) frames[i] = std::move(*s);
-    else errors[i] = s.status();
+    if (s.ok())
+      frames[i] = std::move(*s);
+    else
+      errors[i] = s.status();
   });
   for (const Status& e : errors)
     if (!e.ok()) return e;
   const int width = frames.front().image.cols, height = frames.front().image.rows;
   for (const Sample& s : frames)
     if (s.image.cols != width || s.image.rows != height)
-      return Status::InvalidArgument(s.image_path + ": frame size differs from the split's first frame (" +
+      return Status::InvalidArgument(s.image_path +
+                                     ": frame size differs from the split's first frame (" +
                                      std::to_string(width) + "x" + std::to_string(height) + ")");
 
   // 2. Multilayer regions and the size filter from the training obstacles (§1.4, §4.3).
@@ -112,7 +118,8 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
     bundle.regions = *regions;
     bundle.size_filter = SizeFilter::Derive(obstacle_boxes);
   } else {
-    return Status::InvalidArgument("--regions must be auto or laf2020, got '" + options.regions + "'");
+    return Status::InvalidArgument("--regions must be auto or laf2020, got '" + options.regions +
+                                   "'");
   }
   bundle.size_filter.enabled = options.params.size_filter;
   for (int k = 0; k < bundle.regions.num_layers(); ++k) {
@@ -129,11 +136,13 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   if (options.edge_source == "pixel_forest") {
     std::vector<EdgeTrainingFrame> edge_frames;
     for (int i : classifier_ids)
-      edge_frames.push_back({frames[i].image(r1.rect()).clone(), LabelMap(frames[i])(r1.rect()).clone()});
+      edge_frames.push_back(
+          {frames[i].image(r1.rect()).clone(), LabelMap(frames[i])(r1.rect()).clone()});
     PixelEdgeParams edge_params = options.edge_params;
     edge_params.forest.seed = options.seed;
     say("training the pixel edge classifier on " + std::to_string(edge_frames.size()) + " frames");
-    bundle.edges = std::make_shared<PixelEdgeClassifier>(PixelEdgeClassifier::Train(edge_frames, edge_params));
+    bundle.edges =
+        std::make_shared<PixelEdgeClassifier>(PixelEdgeClassifier::Train(edge_frames, edge_params));
   } else if (options.edge_source == "gradient") {
     bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
   } else if (options.edge_source == "sed") {
@@ -158,7 +167,8 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   });
   OcclusionParams occlusion_params = options.occlusion_params;
   occlusion_params.forest.seed = options.seed;
-  say("training the occlusion classifier on " + std::to_string(occlusion_frames.size()) + " frames");
+  say("training the occlusion classifier on " + std::to_string(occlusion_frames.size()) +
+      " frames");
   bundle.occlusion = OcclusionClassifier::Train(occlusion_frames, occlusion_params);
   occlusion_frames.clear();
   const double occlusion_seconds = SecondsSince(t0);
@@ -174,8 +184,9 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   ParallelFor(n, options.threads, [&](int i) {
     const Sample& s = frames[i];
     if (cv::countNonZero(s.road) > 0) {
-      const OcclusionEdges oaocc = ComputeOcclusionEdges(
-          s.image, bundle.regions, *bundle.edges, &bundle.occlusion, bundle.params.superpixels, true);
+      const OcclusionEdges oaocc =
+          ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges, &bundle.occlusion,
+                                bundle.params.superpixels, true);
       ProposalOptions popts;
       popts.layers_used = bundle.regions.num_layers();
       popts.multistride = bundle.params.multistride;
@@ -197,11 +208,13 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
     const int finished = ++done;
     if (finished % 10 == 0 || finished == n) {
       std::lock_guard lock(say_mutex);
-      say("proposals and samples: " + std::to_string(finished) + "/" + std::to_string(n) + " frames");
+      say("proposals and samples: " + std::to_string(finished) + "/" + std::to_string(n) +
+          " frames");
     }
   });
-  auto stack = [](const std::vector<cv::Mat1f>& parts, const std::vector<std::vector<float>>& targets,
-                  cv::Mat1f& rows, std::vector<float>& y) {
+  auto stack = [](const std::vector<cv::Mat1f>& parts,
+                  const std::vector<std::vector<float>>& targets, cv::Mat1f& rows,
+                  std::vector<float>& y) {
     for (std::size_t i = 0; i < parts.size(); ++i) {
       if (parts[i].empty()) continue;
       rows.push_back(parts[i]);
@@ -213,9 +226,10 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   stack(ordr_rows, ordr_targets, ordr_x, ordr_y);
   stack(obdr_rows, obdr_targets, obdr_x, obdr_y);
   if (ordr_x.rows < 10 || obdr_x.rows < 10)
-    return Status::InvalidArgument(options.data_root + ": too few training samples for the regressors (" +
-                                   std::to_string(ordr_x.rows) + " ORDR, " +
-                                   std::to_string(obdr_x.rows) + " OBDR); need frames with road and obstacles");
+    return Status::InvalidArgument(
+        options.data_root + ": too few training samples for the regressors (" +
+        std::to_string(ordr_x.rows) + " ORDR, " + std::to_string(obdr_x.rows) +
+        " OBDR); need frames with road and obstacles");
   const double proposal_seconds = SecondsSince(t0);
   t0 = Clock::now();
   ForestParams forest = options.regressor;
@@ -230,23 +244,28 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
 
   long long proposals_total = 0;
   for (long long c : proposal_counts) proposals_total += c;
-  bundle.training = {
-      {"data", options.data_root},
-      {"format", format},
-      {"split", options.split},
-      {"frames", n},
-      {"frame_size", {width, height}},
-      {"obstacles", footprints.size()},
-      {"regions_from", options.regions},
-      {"seed", options.seed},
-      {"classifier_frames", classifier_ids.size()},
-      {"mean_proposals_per_frame", static_cast<double>(proposals_total) / n},
-      {"ordr_samples", ordr_x.rows},
-      {"obdr_samples", obdr_x.rows},
-      {"regressor", {{"trees", forest.num_trees}, {"mtry", forest.max_features}, {"min_leaf", forest.min_leaf_size}}},
-      {"seconds", {{"edges", edge_seconds}, {"occlusion", occlusion_seconds},
-                   {"proposals_and_samples", proposal_seconds}, {"regressors", regressor_seconds},
-                   {"total", SecondsSince(started)}}}};
+  bundle.training = {{"data", options.data_root},
+                     {"format", format},
+                     {"split", options.split},
+                     {"frames", n},
+                     {"frame_size", {width, height}},
+                     {"obstacles", footprints.size()},
+                     {"regions_from", options.regions},
+                     {"seed", options.seed},
+                     {"classifier_frames", classifier_ids.size()},
+                     {"mean_proposals_per_frame", static_cast<double>(proposals_total) / n},
+                     {"ordr_samples", ordr_x.rows},
+                     {"obdr_samples", obdr_x.rows},
+                     {"regressor",
+                      {{"trees", forest.num_trees},
+                       {"mtry", forest.max_features},
+                       {"min_leaf", forest.min_leaf_size}}},
+                     {"seconds",
+                      {{"edges", edge_seconds},
+                       {"occlusion", occlusion_seconds},
+                       {"proposals_and_samples", proposal_seconds},
+                       {"regressors", regressor_seconds},
+                       {"total", SecondsSince(started)}}}};
   bundle.version = "tod-" + NowIso8601().substr(0, 10) + "-seed" + std::to_string(options.seed);
   say("trained in " + std::to_string(static_cast<int>(SecondsSince(started))) + " s");
   return bundle;

@@ -17,15 +17,15 @@ namespace tod {
 
 struct TrainOptions {
   std::string data_root;
-  std::string format = "auto";          // auto | laf | modd2
+  std::string format = "auto";  // auto | laf | modd2
   std::string split = "train";
-  std::string regions = "auto";         // auto (k-means on the training obstacles) | laf2020
+  std::string regions = "auto";              // auto (k-means on the training obstacles) | laf2020
   std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
-  std::string sed_model;                // model file for edge_source "sed"
+  std::string sed_model;                     // model file for edge_source "sed"
   std::uint64_t seed = 1;
-  int max_frames = 0;                   // 0 = the whole split
-  int classifier_frames = 60;           // frames used for the edge and occlusion classifiers
-  int threads = 0;                      // 0 = all cores
+  int max_frames = 0;          // 0 = the whole split
+  int classifier_frames = 60;  // frames used for the edge and occlusion classifiers
+  int threads = 0;             // 0 = all cores
   PipelineParams params;
   PixelEdgeParams edge_params;
   OcclusionParams occlusion_params;

@@ -7,10 +7,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/data/synth.h"
 #include "core/pipeline/detector.h"
@@ -36,7 +35,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> order;
   std::size_t proposals = 0;
   for (int r = 0; r < repeats; ++r) {
-    const tod::Sample frame = tod::GenerateSynthFrame(synth, 1000 + static_cast<unsigned>(r), "bench");
+    const tod::Sample frame =
+        tod::GenerateSynthFrame(synth, 1000 + static_cast<unsigned>(r), "bench");
     tod::DetectOptions options;
     options.max_proposals = 1 << 30;
     auto detection = (*detector)->Detect(frame.image, options);
@@ -60,7 +60,8 @@ int main(int argc, char** argv) {
   for (const auto& stage : order) {
     std::vector<double> v = stage_ms[stage];
     std::sort(v.begin(), v.end());
-    std::printf("| %s | %.1f | %.1f | %.1f |\n", stage.c_str(), v[v.size() / 2], v.front(), v.back());
+    std::printf("| %s | %.1f | %.1f | %.1f |\n", stage.c_str(), v[v.size() / 2], v.front(),
+                v.back());
   }
   return 0;
 }

@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -33,7 +32,6 @@ CommandResult Shell(const std::string& command) {
   return run;
 }
 
-
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -41,7 +39,8 @@ class CliTest : public ::testing::Test {
     data_ = tod::testing_env::TestData();
     model_ = tod::testing_env::TestModel();
     ASSERT_TRUE(fs::exists(tod_)) << "TOD_BIN_DIR not set or tod not built";
-    ASSERT_TRUE(fs::exists(fs::path(model_) / "manifest.json")) << "fixture model missing: " << model_;
+    ASSERT_TRUE(fs::exists(fs::path(model_) / "manifest.json"))
+        << "fixture model missing: " << model_;
     out_ = fs::temp_directory_path() /
            ("tod_cli_" + std::to_string(::getpid()) + "_" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
@@ -78,7 +77,8 @@ TEST_F(CliTest, TrainWroteACompleteManifestWithItsOwnEvalNumbers) {
 TEST_F(CliTest, DetectWritesJsonMapAndOverlay) {
   const std::string image = FirstTestImage();
   ASSERT_FALSE(image.empty());
-  const CommandResult run = Shell(tod_ + " detect --model " + model_ + " --out " + out_.string() + " " + image);
+  const CommandResult run =
+      Shell(tod_ + " detect --model " + model_ + " --out " + out_.string() + " " + image);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const std::string stem = fs::path(image).stem().string();
   std::ifstream in(out_ / (stem + ".json"));
@@ -110,11 +110,12 @@ TEST_F(CliTest, DetectWritesJsonMapAndOverlay) {
 }
 
 TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
-  const CommandResult run = Shell(tod_ + " eval --data " + data_ + " --model " + model_ + " --json " +
-                        (out_ / "eval.json").string() + " --plots " + (out_ / "plots").string());
+  const CommandResult run =
+      Shell(tod_ + " eval --data " + data_ + " --model " + model_ + " --json " +
+            (out_ / "eval.json").string() + " --plots " + (out_ / "plots").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  for (const char* v : {"EB", "OLP@1", "OAOCC+OLP@1", "OAOCC+OLP@4", "OAOCC+OLP@4+MS",
-                        "OP+ORDR@4", "BP+ORDR@4", "BP+Fusion@4"})
+  for (const char* v : {"EB", "OLP@1", "OAOCC+OLP@1", "OAOCC+OLP@4", "OAOCC+OLP@4+MS", "OP+ORDR@4",
+                        "BP+ORDR@4", "BP+Fusion@4"})
     EXPECT_NE(run.output.find(v), std::string::npos) << v;
   std::ifstream in(out_ / "eval.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -138,8 +139,8 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
   EXPECT_GE(j["regression"]["BP+Fusion@4"]["tpr_at_fpr"]["0.030"].get<double>(), 0.15);
   EXPECT_GE(j["regression"]["BP+Fusion@4"]["ar"]["1000"].get<double>(), 0.06);
   EXPECT_GE(j["proposals"]["OAOCC+OLP@4+MS"]["ar"]["1000"].get<double>(), 0.05);
-  for (const char* png : {"recall_vs_proposals.png", "recall_vs_iou.png", "ar_vs_proposals.png",
-                          "pixel_roc.png"})
+  for (const char* png :
+       {"recall_vs_proposals.png", "recall_vs_iou.png", "ar_vs_proposals.png", "pixel_roc.png"})
     EXPECT_FALSE(cv::imread((out_ / "plots" / png).string()).empty()) << png;
 }
 
@@ -147,8 +148,8 @@ TEST_F(CliTest, BrokenModelIsRefusedWithTheFileNamed) {
   const fs::path broken = out_ / "broken";
   fs::copy(model_, broken, fs::copy_options::recursive);
   fs::resize_file(broken / "obdr.bin", 10);
-  const CommandResult run = Shell(tod_ + " detect --model " + broken.string() + " --out " + out_.string() +
-                        " " + FirstTestImage());
+  const CommandResult run = Shell(tod_ + " detect --model " + broken.string() + " --out " +
+                                  out_.string() + " " + FirstTestImage());
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.output.find("obdr.bin"), std::string::npos) << run.output;
 }
@@ -156,8 +157,8 @@ TEST_F(CliTest, BrokenModelIsRefusedWithTheFileNamed) {
 TEST_F(CliTest, UnreadableImageIsReportedAndOthersStillProcessed) {
   const fs::path bad = out_ / "corrupt.png";
   std::ofstream(bad) << "this is not a png";
-  const CommandResult run = Shell(tod_ + " detect --model " + model_ + " --out " + out_.string() + " " +
-                        bad.string() + " " + FirstTestImage());
+  const CommandResult run = Shell(tod_ + " detect --model " + model_ + " --out " + out_.string() +
+                                  " " + bad.string() + " " + FirstTestImage());
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.output.find("corrupt.png: not a readable image"), std::string::npos) << run.output;
   const std::string stem = fs::path(FirstTestImage()).stem().string();
@@ -166,7 +167,7 @@ TEST_F(CliTest, UnreadableImageIsReportedAndOthersStillProcessed) {
 
 TEST_F(CliTest, MissingDataAndBadFlagsGiveClearErrors) {
   CommandResult run = Shell(tod_ + " train --data " + (out_ / "nothing").string() + " --out " +
-                  (out_ / "m").string());
+                            (out_ / "m").string());
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.output.find("nothing"), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(out_ / "m"));
@@ -179,7 +180,7 @@ TEST_F(CliTest, MissingDataAndBadFlagsGiveClearErrors) {
 TEST_F(CliTest, SynthIsDeterministicForASeed) {
   for (const std::string name : {"a", "b"}) {
     const CommandResult run = Shell(tod_ + " synth --out " + (out_ / name).string() +
-                          " --train 1 --test 0 --seed 3 --width 128 --height 64");
+                                    " --train 1 --test 0 --seed 3 --width 128 --height 64");
     ASSERT_EQ(run.exit_code, 0) << run.output;
   }
   const auto read = [](const fs::path& p) {

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-
 #include <nlohmann/json.hpp>
 
 #include "core/modd2/modd2_synth.h"
@@ -33,9 +32,9 @@ TEST(Modd2Cli, TrainAndEvalOnMarineScenes) {
   // 4 sequences (1 train, 3 test by the synthetic split), 8 frames each, 480 x 360.
   ASSERT_TRUE(tod::WriteModd2SynthDataset((dir / "modd2").string(), 4, 8, 480, 360, 11).ok());
   const std::string tod = tod::testing_env::BinDir() + "/tod";
-  auto [code, out] = Shell(tod + " train --data " + (dir / "modd2").string() +
-                           " --format modd2 --out " + (dir / "model").string() +
-                           " --seed 3 --trees 20 --no-eval");
+  auto [code, out] =
+      Shell(tod + " train --data " + (dir / "modd2").string() + " --format modd2 --out " +
+            (dir / "model").string() + " --seed 3 --trees 20 --no-eval");
   ASSERT_EQ(code, 0) << out;
   std::ifstream manifest_in(dir / "model" / "manifest.json");
   const nlohmann::json manifest = nlohmann::json::parse(manifest_in);
@@ -44,9 +43,9 @@ TEST(Modd2Cli, TrainAndEvalOnMarineScenes) {
   EXPECT_EQ(manifest["regions"]["image_height"], 360);
   EXPECT_EQ(manifest["training"]["format"], "modd2");
 
-  std::tie(code, out) = Shell(tod + " eval --data " + (dir / "modd2").string() +
-                              " --format modd2 --model " + (dir / "model").string() + " --json " +
-                              (dir / "eval.json").string());
+  std::tie(code, out) =
+      Shell(tod + " eval --data " + (dir / "modd2").string() + " --format modd2 --model " +
+            (dir / "model").string() + " --json " + (dir / "eval.json").string());
   ASSERT_EQ(code, 0) << out;
   std::ifstream eval_in(dir / "eval.json");
   const nlohmann::json eval = nlohmann::json::parse(eval_in);

@@ -35,12 +35,10 @@ cv::Mat1f BruteForceMap(const std::vector<ScoredBox>& kept_top, cv::Size size) {
 
 TEST(ProbabilityMap, MatchesBruteForceAccumulationAndPeaksOnTheObstacle) {
   // Four disjoint boxes above 0.25 (two of them overlapping heavily -> one removed by NMS 0.7).
-  std::vector<ScoredBox> boxes = {{{10, 10, 10, 10}, 0.9f},
-                                  {{11, 10, 10, 10}, 0.8f},  // IoU 0.82 with the first: removed
-                                  {{40, 5, 8, 8}, 0.7f},
-                                  {{5, 30, 12, 6}, 0.6f},
-                                  {{30, 30, 5, 5}, 0.5f},
-                                  {{0, 0, 64, 48}, 0.2f}};  // below 0.25: dropped
+  std::vector<ScoredBox> boxes = {
+      {{10, 10, 10, 10}, 0.9f}, {{11, 10, 10, 10}, 0.8f},  // IoU 0.82 with the first: removed
+      {{40, 5, 8, 8}, 0.7f},    {{5, 30, 12, 6}, 0.6f},
+      {{30, 30, 5, 5}, 0.5f},   {{0, 0, 64, 48}, 0.2f}};  // below 0.25: dropped
   const cv::Mat1f map = AccumulateProbabilityMap(boxes, {64, 48});
   // Kept after NMS: 0.9, 0.7, 0.6, 0.5 -> top half = the 0.9 and 0.7 boxes.
   const cv::Mat1f expected = BruteForceMap({boxes[0], boxes[2]}, {64, 48});
@@ -71,7 +69,8 @@ TEST(ProbabilityMap, ThresholdedComponentsCarryBoxAreaPeakAndMean) {
 }
 
 TEST(RankedAboveThreshold, StrictAndSorted) {
-  const auto r = RankedAboveThreshold({{{0, 0, 1, 1}, 0.25f}, {{1, 1, 1, 1}, 0.3f}, {{2, 2, 1, 1}, 0.9f}}, 0.25f);
+  const auto r = RankedAboveThreshold(
+      {{{0, 0, 1, 1}, 0.25f}, {{1, 1, 1, 1}, 0.3f}, {{2, 2, 1, 1}, 0.9f}}, 0.25f);
   ASSERT_EQ(r.size(), 2u);
   EXPECT_FLOAT_EQ(r[0].score, 0.9f);
   EXPECT_FLOAT_EQ(r[1].score, 0.3f);
