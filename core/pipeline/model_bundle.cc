@@ -72,7 +72,10 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   const fs::path target = fs::absolute(dir);
   std::error_code ec;
   fs::create_directories(target.parent_path(), ec);
-  const std::string suffix = "." + std::to_string(::getpid()) + ".tmp";
+  // Appended rather than built from a literal: GCC 12 warns falsely (-Wrestrict) on
+  // "literal" + std::string.
+  std::string suffix(".");
+  suffix.append(std::to_string(::getpid())).append(".tmp");
   const fs::path tmp = target.parent_path() / (target.filename().string() + suffix);
   fs::remove_all(tmp, ec);
   if (!fs::create_directories(tmp, ec))
