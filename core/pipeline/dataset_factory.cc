@@ -1,5 +1,7 @@
 #include "core/pipeline/dataset_factory.h"
 
+#include <algorithm>
+
 #include "core/data/laf_reader.h"
 #include "core/modd2/modd2_reader.h"
 
@@ -24,6 +26,25 @@ Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& root, const std:
   if (chosen == "laf") return OpenLafDataset(root, split);
   if (chosen == "modd2") return OpenModd2Dataset(root, split);
   return Status::InvalidArgument("unknown dataset format '" + format + "' (auto, laf, modd2)");
+}
+
+Result<FrameSelection> SelectFrames(const std::string& root, const std::string& split,
+                                    const std::string& format, int max_frames) {
+  FrameSelection out;
+  out.format = format;
+  if (out.format == "auto") {
+    auto detected = DetectDatasetFormat(root);
+    if (!detected.ok()) return detected.status();
+    out.format = *detected;
+  }
+  auto dataset = OpenDataset(root, split, out.format);
+  if (!dataset.ok()) return dataset.status();
+  out.dataset = std::move(*dataset);
+  const long long total = static_cast<long long>(out.dataset->size());
+  if (total == 0) return Status::InvalidArgument(root + ": the " + split + " split is empty");
+  const long long n = max_frames > 0 ? std::min<long long>(total, max_frames) : total;
+  for (long long j = 0; j < n; ++j) out.frames.push_back(static_cast<int>(j * total / n));
+  return out;
 }
 
 }  // namespace tod

@@ -70,13 +70,11 @@ std::string Fixed(double v, int digits = 3) {
 }  // namespace
 
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options) {
-  auto dataset = OpenDataset(options.data_root, options.split, options.format);
-  if (!dataset.ok()) return dataset.status();
-  const int total = static_cast<int>((*dataset)->size());
-  const int n = options.max_frames > 0 ? std::min(total, options.max_frames) : total;
-  if (n == 0)
-    return Status::InvalidArgument(options.data_root + ": the " + options.split +
-                                   " split is empty");
+  auto selection =
+      SelectFrames(options.data_root, options.split, options.format, options.max_frames);
+  if (!selection.ok()) return selection.status();
+  const Dataset& dataset = *selection->dataset;
+  const int n = static_cast<int>(selection->frames.size());
 
   std::map<std::string, RecallAccumulator> recall;
   for (const auto& v : ProposalVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
@@ -90,7 +88,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   int done = 0;
 
   ParallelFor(n, options.threads, [&](int i) {
-    auto loaded = (*dataset)->Load(i);
+    auto loaded = dataset.Load(selection->frames[i]);
     if (!loaded.ok()) {
       errors[i] = loaded.status();
       return;

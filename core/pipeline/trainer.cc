@@ -60,27 +60,20 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
     if (options.progress) options.progress(line);
   };
   const auto started = Clock::now();
-  std::string format = options.format;
-  if (format == "auto") {
-    auto detected = DetectDatasetFormat(options.data_root);
-    if (!detected.ok()) return detected.status();
-    format = *detected;
-  }
-  auto dataset = OpenDataset(options.data_root, options.split, format);
-  if (!dataset.ok()) return dataset.status();
-  const int total = static_cast<int>((*dataset)->size());
-  const int n = options.max_frames > 0 ? std::min(total, options.max_frames) : total;
-  if (n == 0)
-    return Status::InvalidArgument(options.data_root + ": the " + options.split +
-                                   " split is empty");
-  const std::vector<int> frame_ids = SpreadIndices(total, n);
+  auto selection =
+      SelectFrames(options.data_root, options.split, options.format, options.max_frames);
+  if (!selection.ok()) return selection.status();
+  const Dataset& dataset = *selection->dataset;
+  const std::string& format = selection->format;
+  const std::vector<int>& frame_ids = selection->frames;
+  const int n = static_cast<int>(frame_ids.size());
 
   // 1. Read the split (kept in memory: every later step visits every frame).
   say("reading " + std::to_string(n) + " training frames from " + options.data_root);
   std::vector<Sample> frames(n);
   std::vector<Status> errors(n);
   ParallelFor(n, options.threads, [&](int i) {
-    auto s = (*dataset)->Load(frame_ids[i]);
+    auto s = dataset.Load(frame_ids[i]);
     if (s.ok())
       frames[i] = std::move(*s);
     else

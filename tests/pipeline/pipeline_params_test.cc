@@ -1,0 +1,41 @@
+#include "core/pipeline/pipeline_params.h"
+
+#include <gtest/gtest.h>
+
+namespace tod {
+namespace {
+
+TEST(PipelineParams, DefaultsAreThePapers) {
+  const PipelineParams p;
+  EXPECT_EQ(p.regions.num_layers, 4);
+  EXPECT_FLOAT_EQ(p.boxes.alpha, 0.65f);
+  EXPECT_FLOAT_EQ(p.boxes.beta, 0.75f);
+  EXPECT_FLOAT_EQ(p.boxes.max_aspect_ratio, 6.f);
+  EXPECT_FLOAT_EQ(p.fusion.beta1, 0.3f);
+  EXPECT_FLOAT_EQ(p.probability_map.nms_iou, 0.7f);
+  EXPECT_TRUE(p.multistride);
+}
+
+TEST(PipelineParams, JsonRoundTripAndMissingKeysKeepDefaults) {
+  PipelineParams p;
+  p.boxes.min_box_area = 60;
+  p.multistride = false;
+  auto back = PipelineParamsFromJson(ToJson(p));
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_FLOAT_EQ(back->boxes.min_box_area, 60.f);
+  EXPECT_FALSE(back->multistride);
+  auto partial = PipelineParamsFromJson({{"fusion", {{"beta1", 0.5}}}});
+  ASSERT_TRUE(partial.ok());
+  EXPECT_FLOAT_EQ(partial->fusion.beta1, 0.5f);
+  EXPECT_FLOAT_EQ(partial->fusion.keep_ratio, 0.5f);
+  EXPECT_EQ(partial->superpixels.k, 1024);
+}
+
+TEST(PipelineParams, WrongTypesAndRangesAreErrors) {
+  EXPECT_FALSE(PipelineParamsFromJson({{"boxes", {{"alpha", "big"}}}}).ok());
+  EXPECT_FALSE(PipelineParamsFromJson({{"boxes", {{"alpha", 1.5}}}}).ok());
+  EXPECT_FALSE(PipelineParamsFromJson({{"fusion", {{"keep_ratio", 2}}}}).ok());
+}
+
+}  // namespace
+}  // namespace tod
