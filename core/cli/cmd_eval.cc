@@ -4,6 +4,7 @@
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
 #include "core/pipeline/evaluator.h"
+#include "core/pipeline/model_bundle.h"
 #include "core/pipeline/plots.h"
 
 namespace tod::cli {
@@ -12,6 +13,7 @@ Runner AddEvalCommand(CLI::App& app) {
   struct Args {
     EvalOptions eval;
     std::string model, json, plots;
+    bool record = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd =
@@ -26,6 +28,8 @@ Runner AddEvalCommand(CLI::App& app) {
   cmd->add_option("--threads", args->eval.threads, "worker threads (0 = all cores)");
   cmd->add_option("--json", args->json, "write the numbers as JSON to this file");
   cmd->add_option("--plots", args->plots, "draw the paper's curves as PNG into this directory");
+  cmd->add_flag("--record", args->record,
+                "store the numbers in the bundle's manifest.json (its own eval numbers)");
   return [args] {
     auto bundle = LoadModelBundle(args->model);
     if (!bundle.ok()) return Fail(bundle.status().message());
@@ -36,6 +40,13 @@ Runner AddEvalCommand(CLI::App& app) {
     std::cout << FormatEvalTables(*report);
     if (!args->json.empty()) {
       const Status st = WriteFileAtomically(args->json, EvalReportToJson(*report).dump(2) + "\n");
+      if (!st.ok()) return Fail(st.message());
+    }
+    if (args->record) {
+      nlohmann::json numbers = EvalReportToJson(*report);
+      numbers["data"] = options.data_root;
+      numbers["split"] = options.split;
+      const Status st = UpdateManifestEval(args->model, numbers);
       if (!st.ok()) return Fail(st.message());
     }
     if (!args->plots.empty()) {

@@ -8,9 +8,9 @@
 
 #include "core/metrics/instance_recall.h"
 #include "core/pipeline/dataset_factory.h"
+#include "core/pipeline/edge_boxes_baseline.h"
 #include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/parallel.h"
-#include "core/proposals/edge_orientation.h"
 
 namespace tod {
 namespace {
@@ -22,20 +22,6 @@ std::vector<Box> BoxesOf(const std::vector<ScoredBox>& boxes) {
   std::vector<Box> out;
   out.reserve(boxes.size());
   for (const auto& b : boxes) out.push_back(b.box);
-  return out;
-}
-
-// The baseline a user would otherwise pick: OpenCV ximgproc Edge Boxes on the same base edge map
-// over R1 (alpha 0.65, beta 0.75, 1000 boxes, OpenCV's other defaults), no size filter.
-std::vector<Box> EdgeBoxesBaseline(const cv::Mat1f& base_edge, const Box& r1) {
-  if (base_edge.empty()) return {};
-  const cv::Mat1f orientation = ComputeEdgeOrientation(base_edge);
-  cv::Ptr<cv::ximgproc::EdgeBoxes> eb = cv::ximgproc::createEdgeBoxes(0.65f, 0.75f);
-  eb->setMaxBoxes(kMaxProposals);
-  std::vector<cv::Rect> rects;
-  eb->getBoundingBoxes(base_edge, orientation, rects);
-  std::vector<Box> out;
-  for (const cv::Rect& r : rects) out.push_back({r.x + r1.x, r.y + r1.y, r.width, r.height});
   return out;
 }
 
@@ -101,7 +87,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const OcclusionEdges plain = ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges,
                                                        &bundle.occlusion, bundle.params.superpixels,
                                                        /*enhance=*/false);
-    const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1);
+    const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1, kMaxProposals);
     const ProposalSet olp1 = ProposeBoxes(plain, geo.regions, bundle.params.boxes,
                                           {1, false, bundle.params.size_filter}, geo.size_filter);
 
