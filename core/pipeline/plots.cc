@@ -21,7 +21,7 @@ std::string Tick(double v) {
 }  // namespace
 
 cv::Mat3b RenderLineChart(const PlotSpec& spec, const std::vector<PlotSeries>& series) {
-  const int width = 800, height = 600, left = 80, right = 20, top = 50, bottom = 70;
+  const int width = 820, height = 600, left = 100, right = 20, top = 50, bottom = 70;
   cv::Mat3b img(height, width, cv::Vec3b(255, 255, 255));
   const cv::Rect area(left, top, width - left - right, height - top - bottom);
   auto px = [&](double x, double y) {

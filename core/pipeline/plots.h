@@ -24,7 +24,7 @@ struct PlotSpec {
   double x_min = 0, x_max = 1, y_min = 0, y_max = 1;
 };
 
-// Renders a chart (800 x 600 BGR).
+// Renders a chart (820 x 600 BGR).
 cv::Mat3b RenderLineChart(const PlotSpec& spec, const std::vector<PlotSeries>& series);
 
 // Writes recall_vs_proposals.png, recall_vs_iou.png, ar_vs_proposals.png, pixel_roc.png into dir.
