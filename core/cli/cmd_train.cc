@@ -41,6 +41,9 @@ Runner AddTrainCommand(CLI::App& app) {
       ->check(CLI::Range(1, 2000));
   cmd->add_option("--threads", args->train.threads, "worker threads (0 = all cores)");
   cmd->add_flag("--no-size-filter", args->no_size_filter, "switch the box size filter off");
+  cmd->add_option("--refine-limit", args->train.params.boxes.refine_limit,
+                  "refine only the N best windows per region (approximation; 0 = exact, all)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,
