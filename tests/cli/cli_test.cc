@@ -11,26 +11,15 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "tests/run_command.h"
 #include "tests/test_env.h"
 
 namespace {
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
+using tod::testing_env::CommandResult;
 
-CommandResult Shell(const std::string& command) {
-  CommandResult run;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe) != nullptr) run.output += buf.data();
-  const int status = ::pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+CommandResult Shell(const std::string& command) { return tod::testing_env::RunCommand(command); }
 
 class CliTest : public ::testing::Test {
  protected:

@@ -11,19 +11,15 @@
 #include <nlohmann/json.hpp>
 
 #include "core/modd2/modd2_synth.h"
+#include "tests/run_command.h"
 #include "tests/test_env.h"
 
 namespace {
 namespace fs = std::filesystem;
 
 std::pair<int, std::string> Shell(const std::string& command) {
-  std::string output;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return {-1, ""};
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe) != nullptr) output += buf.data();
-  const int status = ::pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  const tod::testing_env::CommandResult run = tod::testing_env::RunCommand(command);
+  return {run.exit_code, run.output};
 }
 
 TEST(Modd2Cli, TrainAndEvalOnMarineScenes) {
