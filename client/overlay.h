@@ -1,5 +1,5 @@
-// A picture of a detection for people: the probability map tinted red over the frame, obstacle
-// boxes in red, the best proposals in thin green.
+// A picture of a detection received over the wire, drawn exactly as `tod detect` draws its own
+// overlay (core/pipeline/detection_output.h): the response is turned back into a Detection.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -10,10 +10,9 @@ namespace tod::client {
 
 struct OverlayStyle {
   int proposals_drawn = 10;  // best-first proposals outlined
-  double map_opacity = 0.5;  // red tint at P = 1
 };
 
-// `probability` may be empty (map not requested) or must match the image size.
+// `probability` (8-bit, 255 = 1.0) may be empty (map not requested) or must match the image size.
 cv::Mat3b DrawOverlay(const cv::Mat3b& image, const tod::v1::DetectResponse& response,
                       const cv::Mat1b& probability, const OverlayStyle& style = {});
 
