@@ -28,6 +28,13 @@ Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& root, const std:
   return Status::InvalidArgument("unknown dataset format '" + format + "' (auto, laf, modd2)");
 }
 
+std::vector<int> SpreadIndices(int total, int count) {
+  const long long n = count > 0 ? std::min(total, count) : total;
+  std::vector<int> out;
+  for (long long j = 0; j < n; ++j) out.push_back(static_cast<int>(j * total / n));
+  return out;
+}
+
 Result<FrameSelection> SelectFrames(const std::string& root, const std::string& split,
                                     const std::string& format, int max_frames) {
   FrameSelection out;
@@ -40,10 +47,9 @@ Result<FrameSelection> SelectFrames(const std::string& root, const std::string& 
   auto dataset = OpenDataset(root, split, out.format);
   if (!dataset.ok()) return dataset.status();
   out.dataset = std::move(*dataset);
-  const long long total = static_cast<long long>(out.dataset->size());
+  const int total = static_cast<int>(out.dataset->size());
   if (total == 0) return Status::InvalidArgument(root + ": the " + split + " split is empty");
-  const long long n = max_frames > 0 ? std::min<long long>(total, max_frames) : total;
-  for (long long j = 0; j < n; ++j) out.frames.push_back(static_cast<int>(j * total / n));
+  out.frames = SpreadIndices(total, max_frames);
   return out;
 }
 

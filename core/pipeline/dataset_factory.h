@@ -13,6 +13,10 @@ namespace tod {
 Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& root, const std::string& split,
                                              const std::string& format = "auto");
 
+// At most `count` indices of [0, total) spread evenly, ascending (all of them when count <= 0 or
+// count >= total), so a subset still covers every scene.
+std::vector<int> SpreadIndices(int total, int count);
+
 // A split opened for training or evaluation, with the frames to use: all of them, or at most
 // max_frames spread evenly over the split (so a subset still covers every scene).
 struct FrameSelection {

@@ -96,12 +96,20 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges,
                                                        &bundle.occlusion, bundle.params.superpixels,
                                                        /*enhance=*/true, &timer);
-    ProposalSet bp = ProposeBoxes(oaocc, geo.regions, bundle.params.boxes,
-                                  {layers, true, bundle.params.size_filter}, geo.size_filter);
+    const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
+    std::vector<std::vector<ScoredBox>> ms_regions;
+    for (int k = 0; k < layers; ++k)
+      ms_regions.push_back(
+          ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k, true, filter));
+    ProposalSet bp = MergeRegionBoxes(ms_regions);
     timer.Mark("proposals");
-    std::vector<Box> oaocc1;  // R1 boxes are the same with and without MS (factor 1 in R1)
-    for (std::size_t j = 0; j < bp.boxes.size(); ++j)
-      if (bp.layer[j] == 0) oaocc1.push_back(bp.boxes[j].box);
+    // R1's stride factor is 1 with and without MS, so its boxes serve OAOCC+OLP@1 and OP too;
+    // only R2..RK are scored again without MS.
+    const std::vector<Box> oaocc1 = BoxesOf(ms_regions.front());
+    std::vector<std::vector<ScoredBox>> plain_regions = {ms_regions.front()};
+    for (int k = 1; k < layers; ++k)
+      plain_regions.push_back(
+          ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k, false, filter));
     const std::vector<Box> bp_boxes = BoxesOf(bp.boxes);
     const RegressedProposals bp_reg =
         RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(bp), &timer);
@@ -115,8 +123,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
         AccumulateProbabilityMap(bp_fusion, s.image.size(), bundle.params.probability_map);
     timer.Mark("probability_map");
 
-    ProposalSet op = ProposeBoxes(oaocc, geo.regions, bundle.params.boxes,
-                                  {layers, false, bundle.params.size_filter}, geo.size_filter);
+    ProposalSet op = MergeRegionBoxes(plain_regions);
     const std::vector<Box> op_boxes = BoxesOf(op.boxes);
     const RegressedProposals op_reg =
         RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(op));

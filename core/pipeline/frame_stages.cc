@@ -49,28 +49,32 @@ cv::Mat1f RegionEdgeMap(const OcclusionEdges& oaocc, const MultilayerRegions& re
   return map;
 }
 
-ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
-                         const EdgeBoxParams& box_params, const ProposalOptions& options,
-                         const SizeFilter& size_filter) {
-  const int used = std::clamp(options.layers_used, 1, regions.num_layers());
+std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
+                                          const MultilayerRegions& regions,
+                                          const EdgeBoxParams& box_params, int k, bool multistride,
+                                          const SizeFilter* size_filter) {
+  const cv::Mat1f map = RegionEdgeMap(oaocc, regions, k);
+  if (map.empty()) return {};
+  EdgeBoxParams params = box_params;
+  // §4.2.6: stride factor (K - k + 1) / K with paper index k = this k + 1.
   const int num_layers = regions.num_layers();
-  std::vector<std::pair<ScoredBox, int>> merged;
-  for (int k = 0; k < used; ++k) {
-    const cv::Mat1f map = RegionEdgeMap(oaocc, regions, k);
-    if (map.empty()) continue;
-    EdgeBoxParams params = box_params;
-    // §4.2.6: stride factor (K - k + 1) / K with paper index k = this k + 1.
-    params.stride_factor = options.multistride
-                               ? static_cast<float>(num_layers - k) / static_cast<float>(num_layers)
-                               : 1.f;
-    const Box region = Intersect(regions.layers[k], oaocc.r1);
-    for (ScoredBox b : ScoreEdgeBoxes(NormaliseToMax(map), params)) {
-      b.box.x += region.x;
-      b.box.y += region.y;
-      if (options.size_filter && size_filter.enabled && !size_filter.Keep(b.box)) continue;
-      merged.emplace_back(b, k);
-    }
+  params.stride_factor =
+      multistride ? static_cast<float>(num_layers - k) / static_cast<float>(num_layers) : 1.f;
+  const Box region = Intersect(regions.layers[k], oaocc.r1);
+  std::vector<ScoredBox> out;
+  for (ScoredBox b : ScoreEdgeBoxes(NormaliseToMax(map), params)) {
+    b.box.x += region.x;
+    b.box.y += region.y;
+    if (size_filter != nullptr && size_filter->enabled && !size_filter->Keep(b.box)) continue;
+    out.push_back(b);
   }
+  return out;
+}
+
+ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region) {
+  std::vector<std::pair<ScoredBox, int>> merged;
+  for (std::size_t k = 0; k < per_region.size(); ++k)
+    for (const ScoredBox& b : per_region[k]) merged.emplace_back(b, static_cast<int>(k));
   // No cross-region NMS (authors' code): the union, ranked by objectness.
   std::stable_sort(merged.begin(), merged.end(),
                    [](const auto& a, const auto& b) { return a.first.score > b.first.score; });
@@ -82,6 +86,17 @@ ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& r
     out.layer.push_back(k);
   }
   return out;
+}
+
+ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                         const EdgeBoxParams& box_params, const ProposalOptions& options,
+                         const SizeFilter& size_filter) {
+  const int used = std::clamp(options.layers_used, 1, regions.num_layers());
+  std::vector<std::vector<ScoredBox>> per_region;
+  for (int k = 0; k < used; ++k)
+    per_region.push_back(ProposeRegionBoxes(oaocc, regions, box_params, k, options.multistride,
+                                            options.size_filter ? &size_filter : nullptr));
+  return MergeRegionBoxes(per_region);
 }
 
 cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,

@@ -46,6 +46,15 @@ struct ProposalSet {
   std::vector<int> layer;        // 0-based region that produced each box
 };
 
+// Boxes of region k (0-based) in full-image coordinates, objectness descending, through the size
+// filter when one is given.
+std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
+                                          const MultilayerRegions& regions,
+                                          const EdgeBoxParams& box_params, int k, bool multistride,
+                                          const SizeFilter* size_filter);
+// The union of per-region boxes (index = region), ranked by objectness; no cross-region NMS.
+ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region);
+
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                          const EdgeBoxParams& box_params, const ProposalOptions& options,
                          const SizeFilter& size_filter);

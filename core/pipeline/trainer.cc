@@ -18,18 +18,6 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Evenly spaced subset of [0, n) of at most `count` indices (all when count <= 0 or >= n).
-std::vector<int> SpreadIndices(int n, int count) {
-  std::vector<int> out;
-  if (count <= 0 || count >= n) {
-    for (int i = 0; i < n; ++i) out.push_back(i);
-    return out;
-  }
-  for (int j = 0; j < count; ++j)
-    out.push_back(static_cast<int>((static_cast<long long>(j) * n) / count));
-  return out;
-}
-
 // Rows of `all` selected by `indices`, as a proposal subset for feature extraction.
 ProposalSet Subset(const ProposalSet& all, const std::vector<int>& indices) {
   ProposalSet out;

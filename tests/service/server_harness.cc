@@ -71,6 +71,11 @@ int FreeLoopbackPort() {
   return ntohs(address.sin_port);
 }
 
+std::string TestModel() {
+  const std::string model = tod::testing_env::TestModel();
+  return std::filesystem::exists(std::filesystem::path(model) / "manifest.json") ? model : "";
+}
+
 std::string BinaryPath(const std::string& name) { return tod::testing_env::BinDir() + "/" + name; }
 
 std::string MakeTempDir(const std::string& prefix) {

@@ -5,6 +5,7 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -17,6 +18,9 @@ int FreeLoopbackPort();
 
 // <bin dir>/<name> (tests/test_env.h: configured, or $TOD_BIN_DIR).
 std::string BinaryPath(const std::string& name);
+
+// The tiny model bundle of the CTest fixture (tiny_model), or "" when it does not exist.
+std::string TestModel();
 
 // A fresh empty directory under the system temp directory.
 std::string MakeTempDir(const std::string& prefix);
@@ -63,3 +67,12 @@ std::string ScrapeMetrics(int http_port);
 std::optional<double> MetricValue(const std::string& metrics_text, const std::string& series);
 
 }  // namespace tod::server::testing
+
+// End-to-end tests need the fixture's model and the built server. Missing ones are a failure,
+// not a skip: a broken fixture must not turn the service tests green.
+#define REQUIRE_MODEL()                                                                   \
+  if (::tod::server::testing::TestModel().empty() ||                                      \
+      !std::filesystem::exists(::tod::server::testing::BinaryPath("tod_server"))) {       \
+    GTEST_FAIL() << "no test model bundle or tod_server (run through ctest, which makes " \
+                    "the tiny_model fixture)";                                            \
+  }

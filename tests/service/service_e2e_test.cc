@@ -26,21 +26,11 @@ using testing::MetricValue;
 using testing::RunCommand;
 using testing::ScrapeMetrics;
 using testing::ServerProcess;
+using testing::TestModel;
 
 // Limits the shared server runs with; the error tests go just over them.
 constexpr int kMaxBytes = 400'000;
 constexpr int kMaxPixels = 700 * 400;
-
-std::string TestModel() {
-  const std::string model = tod::testing_env::TestModel();
-  return fs::exists(fs::path(model) / "manifest.json") ? model : "";
-}
-
-#define REQUIRE_MODEL()                                                             \
-  if (TestModel().empty() || !fs::exists(testing::BinaryPath("tod_server"))) {      \
-    GTEST_SKIP() << "no test model bundle or tod_server (run through ctest, which " \
-                    "provides the tiny_model fixture)";                             \
-  }
 
 tod::v1::DetectRequest MakeRequest(const std::string& image, const std::string& frame_id = "") {
   tod::v1::DetectRequest request;

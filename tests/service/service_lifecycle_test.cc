@@ -24,17 +24,7 @@ using namespace std::chrono_literals;
 using testing::MetricValue;
 using testing::ScrapeMetrics;
 using testing::ServerProcess;
-
-std::string TestModel() {
-  const std::string model = tod::testing_env::TestModel();
-  return fs::exists(fs::path(model) / "manifest.json") ? model : "";
-}
-
-#define REQUIRE_MODEL()                                                             \
-  if (TestModel().empty() || !fs::exists(testing::BinaryPath("tod_server"))) {      \
-    GTEST_SKIP() << "no test model bundle or tod_server (run through ctest, which " \
-                    "provides the tiny_model fixture)";                             \
-  }
+using testing::TestModel;
 
 // A frame big enough that the pipeline takes a while, so requests pile up behind it.
 const std::string& BusyFrame() {
