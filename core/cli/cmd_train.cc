@@ -16,6 +16,7 @@ Runner AddTrainCommand(CLI::App& app) {
     std::string out;
     bool no_eval = false;
     bool no_size_filter = false;
+    bool refine_all = false;
     std::string eval_split = "test";
     int eval_frames = 0;
     int trees = 200;
@@ -44,6 +45,8 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--refine-limit", args->train.params.boxes.refine_limit,
                   "refine only the N best windows per region (approximation; 0 = exact, all)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--refine-all", args->refine_all,
+                "refine every scoring window, as the paper (default: grid local maxima only)");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,
@@ -53,6 +56,7 @@ Runner AddTrainCommand(CLI::App& app) {
     if (!options.sed_model.empty() && options.edge_source != "sed") options.edge_source = "sed";
     options.regressor.num_trees = args->trees;
     options.params.size_filter = !args->no_size_filter;
+    if (args->refine_all) options.params.boxes.refine_local_maxima = false;
     options.progress = [](const std::string& line) { std::cerr << "train: " << line << "\n"; };
     auto bundle = TrainModel(options);
     if (!bundle.ok()) return Fail(bundle.status().message());

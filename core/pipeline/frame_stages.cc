@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <optional>
 
 #include "core/features/box_features.h"
 #include "core/features/colour_integrals.h"
@@ -62,10 +63,17 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
       multistride ? static_cast<float>(num_layers - k) / static_cast<float>(num_layers) : 1.f;
   const Box region = Intersect(regions.layers[k], oaocc.r1);
   std::vector<ScoredBox> out;
-  for (ScoredBox b : ScoreEdgeBoxes(NormaliseToMax(map), params)) {
+  const bool filtered = size_filter != nullptr && size_filter->enabled;
+  // Windows that cannot end as a kept box are not scored. Unlike the authors' order (NMS, the
+  // max_boxes cut, then the filter), filtered boxes thus neither suppress kept ones in NMS nor
+  // take places under max_boxes.
+  std::optional<WindowAdmission> admission;
+  if (filtered) admission.emplace(*size_filter, region.y);
+  for (ScoredBox b :
+       ScoreEdgeBoxes(NormaliseToMax(map), params, nullptr, admission ? &*admission : nullptr)) {
     b.box.x += region.x;
     b.box.y += region.y;
-    if (size_filter != nullptr && size_filter->enabled && !size_filter->Keep(b.box)) continue;
+    if (filtered && !size_filter->Keep(b.box)) continue;
     out.push_back(b);
   }
   return out;

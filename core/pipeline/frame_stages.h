@@ -12,6 +12,7 @@
 #include "core/pipeline/multilayer_regions.h"
 #include "core/proposals/edge_box_scorer.h"
 #include "core/proposals/size_filter.h"
+#include "core/proposals/window_admission.h"
 
 namespace tod {
 

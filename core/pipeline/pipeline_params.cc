@@ -15,7 +15,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StickySuperpixelParams, k, alpha
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeBoxParams, alpha, beta, min_score, max_boxes,
                                                 edge_min_mag, edge_merge_thr, cluster_min_mag,
                                                 max_aspect_ratio, min_box_area, gamma, kappa,
-                                                min_stride, refine, refine_limit)
+                                                min_stride, refine, refine_limit,
+                                                refine_local_maxima)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FusionParams, beta1, keep_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score, nms_iou, max_boxes,
                                                 top_fraction)

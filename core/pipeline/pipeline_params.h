@@ -18,7 +18,13 @@ struct PipelineParams {
   RegionParams regions;
   GradientEdgeParams gradient_edges;
   StickySuperpixelParams superpixels;
-  EdgeBoxParams boxes;
+  // The paper's Edge Boxes parameters, except that only the grid's local maxima are refined:
+  // refining every scoring window does not fit the frame budget (README, "Speed").
+  EdgeBoxParams boxes = [] {
+    EdgeBoxParams p;
+    p.refine_local_maxima = true;
+    return p;
+  }();
   bool multistride = true;  // MS: stride factor (K - k + 1) / K in region k (§4.2.6)
   bool size_filter = true;  // §4.3, switchable
   FusionParams fusion;

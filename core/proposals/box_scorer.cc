@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/proposals/edge_orientation.h"
+#include "core/proposals/refinement_schedule.h"
 
 namespace tod {
 namespace {
@@ -184,41 +185,60 @@ void BoxScorer::ScoreImpl(ScoreWindow& w, float bar, bool use_bound) {
   w.score = ScoreAfterBound(w, inner_r0, inner_c0, inner_r1, inner_c1, norm, bar);
 }
 
-void BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
-                            std::vector<ScoreWindow>& nonzero) {
+int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
+                           const RowRanges* tops, std::vector<ScoreWindow>& nonzero,
+                           std::vector<int>* rows) {
+  int visited = 0;
   // Score() on each window of the column, with the per-column work hoisted: the clamped
   // columns, the centre box's columns and the bound's integral-image columns.
   const int c0 = std::clamp(x, 0, width_ - 1), c1 = std::clamp(x + box_width, 0, width_ - 1);
   const int half_w = (c1 - c0) / 2;
   const int inner_c0 = c0 + half_w / 2, inner_c1 = inner_c0 + half_w;
   const ContainmentBound::Columns columns = t_->bound.ColumnsOf(c0, c1, inner_c0, inner_c1);
+  int y = 0;
   const auto score_rest = [&](int r0, int r1, int inner_r0, int inner_r1, float norm) {
     const ScoreWindow w{r0, c0, r1, c1, 0.f};
     const float score = ScoreAfterBound(w, inner_r0, inner_c0, inner_r1, inner_c1, norm, -1.f);
-    if (score > 0.f) nonzero.push_back(ScoreWindow{r0, c0, r1, c1, score});
+    if (score <= 0.f) return;
+    nonzero.push_back(ScoreWindow{r0, c0, r1, c1, score});
+    if (rows != nullptr) rows->push_back(y / stride_y);
+  };
+  // The first grid row at or after `row`.
+  const auto grid_row_from = [stride_y](int row) {
+    return row <= 0 ? 0 : (row + stride_y - 1) / stride_y * stride_y;
   };
   const int y_end = height_ - box_height + stride_y;
-  int y = 0;
   // Windows that need no clamping share their size, so the bound test is one integer compare
   // against the threshold that Hopeless() puts on the fixed-point bound.
   const int unclamped_end = std::min(y_end, height_ - box_height);
-  if (box_height >= 0 && y < unclamped_end) {
+  if (box_height >= 0 && unclamped_end > 0) {
     const int half_h = box_height / 2, inner_offset = half_h / 2;
     const float norm = t_->norm[half_w + half_h];
     const std::int64_t threshold =
         t_->bound.SmallestHopeful([&](double v) { return Hopeless(v, norm, -1.f); });
-    if (threshold == ContainmentBound::kNever) {
-      y = unclamped_end + (stride_y - unclamped_end % stride_y) % stride_y;  // none can pass
-    }
-    for (; y < unclamped_end; y += stride_y) {
-      const int inner_r0 = y + inner_offset;
-      if (!t_->bound.Reaches(columns, y, y + box_height, inner_r0, inner_r0 + half_h, threshold)) {
-        continue;
+    const auto scan = [&](int begin, int end) {
+      end = std::min(end, unclamped_end);
+      for (y = grid_row_from(begin); y < end; y += stride_y) {
+        ++visited;
+        const int inner_r0 = y + inner_offset;
+        if (!t_->bound.Reaches(columns, y, y + box_height, inner_r0, inner_r0 + half_h,
+                               threshold)) {
+          continue;
+        }
+        score_rest(y, y + box_height, inner_r0, inner_r0 + half_h, norm);
       }
-      score_rest(y, y + box_height, inner_r0, inner_r0 + half_h, norm);
+    };
+    if (threshold == ContainmentBound::kNever) {
+      // No window of this size can pass: they count as visited, the bound decided them all.
+      visited += (unclamped_end + stride_y - 1) / stride_y;
+    } else if (tops == nullptr) {
+      scan(0, unclamped_end);
+    } else {
+      for (const auto& [begin, end] : *tops) scan(begin, end);
     }
   }
-  for (; y < y_end; y += stride_y) {  // the clamped windows at the bottom
+  for (y = grid_row_from(unclamped_end); y < y_end; y += stride_y) {  // the clamped windows
+    ++visited;
     const int r0 = std::min(y, height_ - 1), r1 = std::min(y + box_height, height_ - 1);
     const int half_h = (r1 - r0) / 2;
     const int inner_r0 = r0 + half_h / 2, inner_r1 = inner_r0 + half_h;
@@ -226,6 +246,7 @@ void BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
     if (Hopeless(t_->bound.Bound(columns, r0, r1, inner_r0, inner_r1), norm, -1.f)) continue;
     score_rest(r0, r1, inner_r0, inner_r1, norm);
   }
+  return visited;
 }
 
 float BoxScorer::ScoreAfterBound(const ScoreWindow& w, int inner_r0, int inner_c0, int inner_r1,
@@ -314,8 +335,8 @@ float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm,
 
 void BoxScorer::Refine(ScoreWindow& box) {
   // Steps from the unmodified ratio (1 - alpha) / (1 + alpha): MS changes only the grid (§4.2.7).
-  int row_step = static_cast<int>(static_cast<float>(box.r1 - box.r0) * refine_ratio_);
-  int col_step = static_cast<int>(static_cast<float>(box.c1 - box.c0) * refine_ratio_);
+  const RefinementSchedule schedule =
+      ScheduleRefinement(box.r1 - box.r0, box.c1 - box.c0, refine_ratio_);
   // Tries moving one side outwards, then inwards; keeps the better window if it improves.
   // Candidates only need to beat box.score, so that is the bar for their walks.
   auto search = [this, &box](int ScoreWindow::*side, int step) {
@@ -329,16 +350,11 @@ void BoxScorer::Refine(ScoreWindow& box) {
     }
     if (candidate.score > box.score) box = candidate;
   };
-  while (true) {
-    row_step /= 2;
-    col_step /= 2;
-    if (row_step <= 2 && col_step <= 2) break;
-    row_step = std::max(1, row_step);
-    col_step = std::max(1, col_step);
-    search(&ScoreWindow::r0, row_step);   // top: grow = move up
-    search(&ScoreWindow::r1, -row_step);  // bottom: grow = move down
-    search(&ScoreWindow::c0, col_step);
-    search(&ScoreWindow::c1, -col_step);
+  for (int i = 0; i < schedule.count; ++i) {
+    search(&ScoreWindow::r0, schedule.row_step[i]);   // top: grow = move up
+    search(&ScoreWindow::r1, -schedule.row_step[i]);  // bottom: grow = move down
+    search(&ScoreWindow::c0, schedule.col_step[i]);
+    search(&ScoreWindow::c1, -schedule.col_step[i]);
   }
 }
 

@@ -11,6 +11,7 @@
 #include "core/proposals/containment_bound.h"
 #include "core/proposals/edge_box_scorer.h"
 #include "core/proposals/edge_groups.h"
+#include "core/proposals/window_admission.h"
 
 namespace tod {
 
@@ -34,9 +35,12 @@ class BoxScorer {
   void Score(ScoreWindow& window, float bar = -1.f);
   // Scores the sliding-window column at x of one window shape (nominal extent box_width x
   // box_height, row stride stride_y; rows y = 0, stride_y, ... while y < height - box_height +
-  // stride_y) exactly as Score() would, and appends the clamped windows with a non-zero score.
-  void ScoreColumn(int x, int box_width, int box_height, int stride_y,
-                   std::vector<ScoreWindow>& nonzero);
+  // stride_y) exactly as Score() would, and appends the clamped windows with a non-zero score
+  // (and, with `rows`, their grid row index y / stride_y). With `tops`, only the unclamped
+  // windows whose top row lies in one of those ranges are scored (the clamped ones always are).
+  // Returns how many windows it visited.
+  int ScoreColumn(int x, int box_width, int box_height, int stride_y, const RowRanges* tops,
+                  std::vector<ScoreWindow>& nonzero, std::vector<int>* rows = nullptr);
   // Coordinate search on the four sides with halving steps, accepting improvements.
   void Refine(ScoreWindow& window);
 

@@ -56,13 +56,18 @@ std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxPa
 
 std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxParams& params,
                                       EdgeBoxStats* stats) {
+  return ScoreEdgeBoxes(edge_map, params, stats, nullptr);
+}
+
+std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxParams& params,
+                                      EdgeBoxStats* stats, const WindowAdmission* admission) {
   EdgeBoxStats local;
   EdgeBoxStats& s = stats != nullptr ? *stats : local;
   s = EdgeBoxStats{};
   if (!Usable(edge_map) || !ValidateEdgeBoxParams(params).ok()) return {};
 
   const BoxScorer scorer(edge_map, params);
-  std::vector<ScoredBox> kept = ScanWindowGrid(scorer, params, s);
+  std::vector<ScoredBox> kept = ScanWindowGrid(scorer, params, s, admission);
   s.boxes_out = static_cast<long long>(kept.size());
   return kept;
 }

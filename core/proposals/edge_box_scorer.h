@@ -12,6 +12,8 @@
 
 namespace tod {
 
+class WindowAdmission;
+
 struct EdgeBoxParams {
   float alpha = 0.65f;  // step / IoU between neighbouring windows
   float beta = 0.75f;   // NMS IoU
@@ -32,6 +34,10 @@ struct EdgeBoxParams {
   // keep their grid box and score. Refinement is most of the scoring time; see
   // bench_proposals_olp for the speed / recall trade-off.
   int refine_limit = 0;
+  // APPROXIMATION: refine only the windows whose grid score no grid neighbour of the same shape
+  // (one stride away in x, y or both) exceeds; the others keep their grid box and score. With
+  // dense strides neighbouring windows climb to the same box, so most refinement is repeated.
+  bool refine_local_maxima = false;
   // Worker threads for the window grid: 1 = the calling thread only, 0 = all hardware threads.
   // The output is identical for every value (deterministic merge, §4.2.8 NMS on a total order).
   int threads = 1;
@@ -43,7 +49,7 @@ Status ValidateEdgeBoxParams(const EdgeBoxParams& params);
 
 // Work counters of one ScoreEdgeBoxes call (for benchmarks and logs).
 struct EdgeBoxStats {
-  long long windows_visited = 0;          // grid windows scored
+  long long windows_visited = 0;          // grid windows scored (only admitted ones, with one)
   long long windows_past_early_exit = 0;  // grid windows that reached the boundary-affinity walk
   long long windows_nonzero = 0;          // grid windows with a final score > 0
   long long windows_refined = 0;          // of those, refined (all unless refine_limit)
@@ -59,6 +65,10 @@ struct EdgeBoxStats {
 std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxParams& params);
 std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxParams& params,
                                       EdgeBoxStats* stats);
+// With `admission` (may be null), windows that cannot end as a box the size filter keeps are not
+// scored (see WindowAdmission); the caller still filters the output.
+std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxParams& params,
+                                      EdgeBoxStats* stats, const WindowAdmission* admission);
 
 // Scores one given box on the map (the same score the sliding window gives, no refinement).
 // The box is clipped to the map; 0 for an empty box, empty map or invalid parameters.

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <thread>
 
+#include "core/proposals/refinement_schedule.h"
 #include "core/proposals/window_grid.h"
 
 namespace tod {
@@ -55,6 +56,8 @@ long long ParallelChunks(const BoxScorer& prototype, size_t chunks, int threads,
 
 struct ColumnChunk {
   std::vector<ScoreWindow> hits;  // windows with a non-zero score, grid order
+  std::vector<int> rows;          // grid row index of each hit
+  std::vector<int> hit_end;       // per column of the chunk: end of its hits in `hits`
   long long windows = 0;
   long long walks = 0;
 };
@@ -74,6 +77,40 @@ std::vector<size_t> WindowsToRefine(const std::vector<ScoreWindow>& hits, int re
   return chosen;
 }
 
+// Of `candidates` (grid order), the windows whose grid score no grid neighbour of the same shape
+// (one stride away in x, y or both) exceeds.
+std::vector<size_t> LocalMaxima(const std::vector<ScoreWindow>& hits, const std::vector<int>& rows,
+                                const std::vector<size_t>& column_begin,
+                                const std::vector<GridColumn>& columns,
+                                const std::vector<size_t>& candidates) {
+  std::vector<size_t> kept;
+  kept.reserve(candidates.size() / 4);
+  size_t column = 0;
+  // Best score among the hits of column c at grid rows [row - 1, row + 1].
+  const auto best_near = [&](size_t c, int row) {
+    const auto first = rows.begin() + static_cast<std::ptrdiff_t>(column_begin[c]);
+    const auto last = rows.begin() + static_cast<std::ptrdiff_t>(column_begin[c + 1]);
+    float best = 0.f;
+    for (auto it = std::lower_bound(first, last, row - 1); it != last && *it <= row + 1; ++it) {
+      best = std::max(best, hits[static_cast<size_t>(it - rows.begin())].score);
+    }
+    return best;
+  };
+  for (const size_t i : candidates) {
+    while (column_begin[column + 1] <= i) ++column;
+    const int row = rows[i];
+    float best = best_near(column, row);
+    if (column > 0 && columns[column - 1].shape == columns[column].shape) {
+      best = std::max(best, best_near(column - 1, row));
+    }
+    if (column + 1 < columns.size() && columns[column + 1].shape == columns[column].shape) {
+      best = std::max(best, best_near(column + 1, row));
+    }
+    if (hits[i].score >= best) kept.push_back(i);
+  }
+  return kept;
+}
+
 }  // namespace
 
 int ResolveThreadCount(int requested) {
@@ -82,8 +119,9 @@ int ResolveThreadCount(int requested) {
 }
 
 std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxParams& params,
-                                      EdgeBoxStats& stats) {
+                                      EdgeBoxStats& stats, const WindowAdmission* admission) {
   const int threads = ResolveThreadCount(params.threads);
+  const float refine_ratio = (1.f - params.alpha) / (1.f + params.alpha);
   const std::vector<WindowShape> shapes = WindowShapes(scorer.width(), scorer.height(), params);
   std::vector<GridColumn> columns;
   for (int s = 0; s < static_cast<int>(shapes.size()); ++s) {
@@ -101,16 +139,32 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
     const long long walks_before = s.past_early_exit();
     for (size_t i = c * kColumnsPerChunk; i < end; ++i) {
       const WindowShape& shape = shapes[columns[i].shape];
-      out.windows += WindowPositionCount(s.height(), shape.height, shape.stride_y);
-      s.ScoreColumn(columns[i].x, shape.width, shape.height, shape.stride_y, out.hits);
+      RowRanges tops;
+      if (admission != nullptr) {
+        // The column's clamped width, and how far refinement can move its sides.
+        const int c0 = std::min(columns[i].x, s.width() - 1);
+        const int c1 = std::min(columns[i].x + shape.width, s.width() - 1);
+        const RefinementSchedule schedule = ScheduleRefinement(shape.height, c1 - c0, refine_ratio);
+        const RefinementReach reach = params.refine
+                                          ? RefinementReach{schedule.row_reach, schedule.col_reach}
+                                          : RefinementReach{};
+        tops = admission->AdmittedTops(c1 - c0 + 1, shape.height + 1, reach, s.height());
+      }
+      out.windows += s.ScoreColumn(columns[i].x, shape.width, shape.height, shape.stride_y,
+                                   admission != nullptr ? &tops : nullptr, out.hits, &out.rows);
+      out.hit_end.push_back(static_cast<int>(out.hits.size()));
     }
     out.walks = s.past_early_exit() - walks_before;
   });
   std::vector<ScoreWindow> hits;
+  std::vector<int> hit_rows;
+  std::vector<size_t> column_begin{0};  // hits of column i: [column_begin[i], column_begin[i+1])
   for (ColumnChunk& chunk : scanned) {
     stats.windows_visited += chunk.windows;
     stats.windows_past_early_exit += chunk.walks;
+    for (const int end : chunk.hit_end) column_begin.push_back(hits.size() + end);
     hits.insert(hits.end(), chunk.hits.begin(), chunk.hits.end());
+    hit_rows.insert(hit_rows.end(), chunk.rows.begin(), chunk.rows.end());
     chunk.hits = {};
   }
   stats.windows_nonzero = static_cast<long long>(hits.size());
@@ -118,7 +172,10 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
   // Pass 2: refinement (step 7) in grid order - neighbouring windows share cache lines, which
   // matters more than anything an order by score bounds could skip - then NMS (step 8).
   if (params.refine) {
-    const std::vector<size_t> chosen = WindowsToRefine(hits, params.refine_limit);
+    std::vector<size_t> chosen = WindowsToRefine(hits, params.refine_limit);
+    if (params.refine_local_maxima) {
+      chosen = LocalMaxima(hits, hit_rows, column_begin, columns, chosen);
+    }
     const size_t chunks = (chosen.size() + kRefinementsPerChunk - 1) / kRefinementsPerChunk;
     stats.scorings += ParallelChunks(scorer, chunks, threads, [&](BoxScorer& s, size_t c) {
       const size_t end = std::min(chosen.size(), (c + 1) * kRefinementsPerChunk);

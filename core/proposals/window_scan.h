@@ -16,8 +16,10 @@ namespace tod {
 // as half-open boxes of the scored pixel set. `threads` as in EdgeBoxParams (0 = all hardware
 // threads). Fills the counters of `stats` except boxes_out. Each thread works on its own copy of
 // `scorer`.
+// With `admission`, windows that cannot end as a box the size filter keeps are not scored.
 std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxParams& params,
-                                      EdgeBoxStats& stats);
+                                      EdgeBoxStats& stats,
+                                      const WindowAdmission* admission = nullptr);
 
 // Threads actually used for a request: 0 = std::thread::hardware_concurrency() (at least 1).
 int ResolveThreadCount(int requested);

@@ -30,7 +30,7 @@ TEST(Modd2Cli, TrainAndEvalOnMarineScenes) {
   const std::string tod = tod::testing_env::BinDir() + "/tod";
   auto [code, out] =
       Shell(tod + " train --data " + (dir / "modd2").string() + " --format modd2 --out " +
-            (dir / "model").string() + " --seed 3 --trees 20 --no-eval");
+            (dir / "model").string() + " --seed 3 --trees 20 --no-eval --refine-all");
   ASSERT_EQ(code, 0) << out;
   std::ifstream manifest_in(dir / "model" / "manifest.json");
   const nlohmann::json manifest = nlohmann::json::parse(manifest_in);
@@ -38,6 +38,8 @@ TEST(Modd2Cli, TrainAndEvalOnMarineScenes) {
   EXPECT_EQ(manifest["regions"]["image_width"], 480);
   EXPECT_EQ(manifest["regions"]["image_height"], 360);
   EXPECT_EQ(manifest["training"]["format"], "modd2");
+  // --refine-all: the paper's refinement of every scoring window, recorded with the model.
+  EXPECT_EQ(manifest["params"]["boxes"]["refine_local_maxima"], false);
 
   std::tie(code, out) =
       Shell(tod + " eval --data " + (dir / "modd2").string() + " --format modd2 --model " +

@@ -20,20 +20,6 @@
 namespace tod {
 namespace {
 
-// Random closed contours and lines of random strength, some below edge_min_mag.
-cv::Mat1f RandomContourMap(int width, int height, unsigned seed, int shapes) {
-  std::mt19937 rng(seed);
-  cv::Mat1f map(height, width, 0.f);
-  std::uniform_int_distribution<int> x(0, width - 1), y(0, height - 1), rad(2, 20);
-  std::uniform_real_distribution<float> mag(0.03f, 1.f);
-  for (int i = 0; i < shapes; ++i) {
-    cv::circle(map, {x(rng), y(rng)}, rad(rng), cv::Scalar(mag(rng)));
-    cv::rectangle(map, cv::Rect(x(rng), y(rng), rad(rng), rad(rng)), cv::Scalar(mag(rng)));
-    cv::line(map, {x(rng), y(rng)}, {x(rng), y(rng)}, cv::Scalar(mag(rng)));
-  }
-  return NormaliseToMax(map);
-}
-
 EdgeGroups GroupsOf(const cv::Mat1f& map, const EdgeBoxParams& p) {
   return BuildEdgeGroups(map, ComputeEdgeOrientation(map),
                          {p.edge_min_mag, p.edge_merge_thr, p.cluster_min_mag, p.gamma});
@@ -43,7 +29,7 @@ TEST(ContainmentBoundTest, NeverBelowTheExactRemainderAndOftenTighterThanV) {
   const EdgeBoxParams params;
   int tighter = 0, boxes = 0;
   for (const unsigned seed : {1u, 2u, 3u}) {
-    const cv::Mat1f map = RandomContourMap(150, 110, seed, 6 + 6 * static_cast<int>(seed));
+    const cv::Mat1f map = testing::RandomContourMap(150, 110, seed, 6 + 6 * static_cast<int>(seed));
     const EdgeGroups groups = GroupsOf(map, params);
     ASSERT_GT(groups.count(), 10);
     const ContainmentBound bound(groups, map, params.edge_min_mag);
@@ -107,7 +93,7 @@ std::vector<ScoredBox> PlainScan(const cv::Mat1f& map, const EdgeBoxParams& para
 }
 
 TEST(ScoreEdgeBoxesTest, ColumnScanAndThreadsEqualThePlainWindowLoop) {
-  const cv::Mat1f map = RandomContourMap(140, 100, 9, 14);
+  const cv::Mat1f map = testing::RandomContourMap(140, 100, 9, 14);
   for (const float factor : {1.f, 0.5f}) {
     EdgeBoxParams params;
     params.stride_factor = factor;
@@ -143,7 +129,7 @@ namespace tod {
 namespace {
 
 TEST(ScoreEdgeBoxesTest, RefineLimitIsExactWhenItCoversEveryWindowAndCutsWorkBelow) {
-  const cv::Mat1f map = RandomContourMap(140, 100, 4, 14);
+  const cv::Mat1f map = testing::RandomContourMap(140, 100, 4, 14);
   EdgeBoxParams params;
   EdgeBoxStats exact_stats, limited_stats, plain_stats;
   const auto exact = ScoreEdgeBoxes(map, params, &exact_stats);
