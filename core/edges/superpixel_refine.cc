@@ -15,9 +15,11 @@ struct LabelSums {
   double c0 = 0.0;
   double c1 = 0.0;
   double c2 = 0.0;
+  double inverse_count = 0.0;  // 1 / count (0 when empty): a division per move, not per cost
 
   void Add(double sign, int px, int py, const float* c) {
     count += sign;
+    inverse_count = count > 0 ? 1.0 / count : 0.0;
     x += sign * px;
     y += sign * py;
     c0 += sign * c[0];
@@ -59,22 +61,25 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
       for (int x = 0; x < width; ++x) {
         const size_t i = static_cast<size_t>(y) * width + x;
         const int own = labels[i];
+        // Interior pixels (every 4-neighbour shares the label) cannot move: decided from the
+        // labels alone, before any edge value is loaded.
+        const bool on_border =
+            (x > 0 && labels[i - 1] != own) || (y > 0 && labels[i - width] != own) ||
+            (x + 1 < width && labels[i + 1] != own) || (y + 1 < height && labels[i + width] != own);
+        if (!on_border) continue;
         // 4-neighbours in the order left, up, right, down (ties go to the earliest candidate).
         std::array<int, 4> nb_label;
         std::array<float, 4> nb_edge;
         int nb_count = 0;
-        bool on_border = false;
         auto push = [&](size_t j) {
           nb_label[nb_count] = labels[j];
           nb_edge[nb_count] = image.edge[j];
-          on_border |= labels[j] != own;
           ++nb_count;
         };
         if (x > 0) push(i - 1);
         if (y > 0) push(i - width);
         if (x + 1 < width) push(i + 1);
         if (y + 1 < height) push(i + width);
-        if (!on_border) continue;
 
         const float* c = image.colour + 3 * i;
         const double px = x;
@@ -84,7 +89,7 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
           // Size counted as if the pixel belonged to t (it already does when t is its own label):
           // with every pixel its own label initially this is what lets singletons merge.
           const double n = s.count + (t == own ? 0.0 : 1.0);
-          const double inv = s.count > 0 ? 1.0 / s.count : 0.0;
+          const double inv = s.inverse_count;
           const double dx = px - s.x * inv;
           const double dy = py - s.y * inv;
           const double d0 = c[0] - s.c0 * inv;
