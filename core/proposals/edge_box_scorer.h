@@ -29,15 +29,15 @@ struct EdgeBoxParams {
   float stride_factor = 1.f;     // MS: (K - k + 1) / K for region k; 1 = plain sliding window
   int min_stride = 2;            // px
   bool refine = true;
-  // APPROXIMATION, off by default (0 = refine every window with a non-zero score, as Edge Boxes
-  // and the paper do). N > 0 refines only the N windows with the best grid scores; the others
-  // keep their grid box and score. Refinement is most of the scoring time; see
-  // bench_proposals_olp for the speed / recall trade-off.
-  int refine_limit = 0;
-  // APPROXIMATION: refine only the windows whose grid score no grid neighbour of the same shape
-  // (one stride away in x, y or both) exceeds; the others keep their grid box and score. With
-  // dense strides neighbouring windows climb to the same box, so most refinement is repeated.
+  // Edge Boxes and the paper refine every window with a non-zero score (the defaults here).
+  // Two APPROXIMATIONS narrow that down; windows left out keep their grid box and score:
+  // refine_local_maxima refines only the windows whose grid score no grid neighbour of the same
+  // shape (one stride away in x, y or both) exceeds - with dense strides neighbouring windows
+  // climb to the same box, so most refinement is repeated work; refine_limit N > 0 then keeps
+  // only the N best of those by grid score (0 = no limit). See bench_pipeline_proposals and the
+  // README for the measured speed / recall trade-off.
   bool refine_local_maxima = false;
+  int refine_limit = 0;
   // Worker threads for the window grid: 1 = the calling thread only, 0 = all hardware threads.
   // The output is identical for every value (deterministic merge, §4.2.8 NMS on a total order).
   int threads = 1;

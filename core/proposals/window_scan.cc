@@ -62,19 +62,20 @@ struct ColumnChunk {
   long long walks = 0;
 };
 
-// Indexes of the windows to refine: all, or the refine_limit best by grid score (ties: grid
-// order), in grid order.
-std::vector<size_t> WindowsToRefine(const std::vector<ScoreWindow>& hits, int refine_limit) {
-  std::vector<size_t> chosen(hits.size());
-  std::iota(chosen.begin(), chosen.end(), size_t{0});
-  if (refine_limit <= 0 || static_cast<size_t>(refine_limit) >= hits.size()) return chosen;
+// Of `candidates` (grid order), all or the refine_limit best by grid score (ties: grid order),
+// in grid order.
+std::vector<size_t> BestByGridScore(const std::vector<ScoreWindow>& hits,
+                                    std::vector<size_t> candidates, int refine_limit) {
+  if (refine_limit <= 0 || static_cast<size_t>(refine_limit) >= candidates.size()) {
+    return candidates;
+  }
   const auto better = [&hits](size_t a, size_t b) {
     return hits[a].score > hits[b].score || (hits[a].score == hits[b].score && a < b);
   };
-  std::nth_element(chosen.begin(), chosen.begin() + refine_limit, chosen.end(), better);
-  chosen.resize(static_cast<size_t>(refine_limit));
-  std::sort(chosen.begin(), chosen.end());
-  return chosen;
+  std::nth_element(candidates.begin(), candidates.begin() + refine_limit, candidates.end(), better);
+  candidates.resize(static_cast<size_t>(refine_limit));
+  std::sort(candidates.begin(), candidates.end());
+  return candidates;
 }
 
 // Of `candidates` (grid order), the windows whose grid score no grid neighbour of the same shape
@@ -172,10 +173,13 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
   // Pass 2: refinement (step 7) in grid order - neighbouring windows share cache lines, which
   // matters more than anything an order by score bounds could skip - then NMS (step 8).
   if (params.refine) {
-    std::vector<size_t> chosen = WindowsToRefine(hits, params.refine_limit);
+    // Local maxima first, so that refine_limit picks the best of them.
+    std::vector<size_t> chosen(hits.size());
+    std::iota(chosen.begin(), chosen.end(), size_t{0});
     if (params.refine_local_maxima) {
       chosen = LocalMaxima(hits, hit_rows, column_begin, columns, chosen);
     }
+    chosen = BestByGridScore(hits, std::move(chosen), params.refine_limit);
     const size_t chunks = (chosen.size() + kRefinementsPerChunk - 1) / kRefinementsPerChunk;
     stats.scorings += ParallelChunks(scorer, chunks, threads, [&](BoxScorer& s, size_t c) {
       const size_t end = std::min(chosen.size(), (c + 1) * kRefinementsPerChunk);

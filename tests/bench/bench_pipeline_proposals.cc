@@ -1,16 +1,20 @@
-// OLP proposal work per region on the occlusion maps a trained model really produces (the
-// proposals stage is most of a frame's time): for each region R1..RK, the map size, the MS
-// stride factor, the windows of the grid, how many ran the boundary-affinity walk, how many
-// scored, all walks with refinement, the boxes out, and the median milliseconds of the grid
-// alone and of grid + refinement + NMS. Prints a table; asserts nothing.
-//   bench_pipeline_proposals MODEL_DIR [FRAMES=3] [WIDTH=2048 HEIGHT=1024] [REFINE_LIMIT=0]
-// Frames are synthetic scenes (seeded, as in bench_pipeline_frame); one core.
+// OLP proposal work on the occlusion maps a trained model really produces (the proposals stage
+// is the largest part of a frame), measured side by side in one run for three configurations:
+//   paper        every scoring window refined; the size filter runs on the output only
+//   +admission   windows that cannot end as a box the size filter keeps are not scored
+//   +local-max   and only the grid's local maxima are refined (the model default)
+// Per configuration: median milliseconds per frame over all regions (scoring + refinement +
+// NMS, one core), grid windows scored, walks, windows refined, and the boxes that pass the size
+// filter. Then, for the model's own configuration, the same per region. Asserts nothing.
+//   bench_pipeline_proposals MODEL_DIR [FRAMES=3] [WIDTH=2048 HEIGHT=1024]
+// Frames are synthetic scenes (seeded, as in bench_pipeline_frame).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/data/synth.h"
@@ -26,26 +30,31 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-template <typename F>
-double TimeMs(F&& f) {
-  const auto start = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
-struct RegionRow {
-  int width = 0, height = 0;
-  float stride_factor = 0.f;
-  tod::EdgeBoxStats stats;  // summed over frames
-  std::vector<double> grid_ms, full_ms;
+struct Config {
+  std::string name;
+  bool admission = false;
+  bool local_maxima = false;
 };
+
+struct Totals {
+  tod::EdgeBoxStats stats;  // summed over frames
+  long long kept = 0;       // boxes through the size filter, summed over frames
+  std::vector<double> ms;   // per frame (config totals) or per frame for one region
+};
+
+void Add(Totals& t, const tod::EdgeBoxStats& s, long long kept) {
+  t.stats.windows_visited += s.windows_visited;
+  t.stats.windows_past_early_exit += s.windows_past_early_exit;
+  t.stats.windows_refined += s.windows_refined;
+  t.stats.scorings += s.scorings;
+  t.kept += kept;
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s MODEL_DIR [FRAMES] [WIDTH HEIGHT] [REFINE_LIMIT]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s MODEL_DIR [FRAMES] [WIDTH HEIGHT]\n", argv[0]);
     return 2;
   }
   const int frames = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
@@ -54,7 +63,6 @@ int main(int argc, char** argv) {
     synth.width = std::atoi(argv[3]);
     synth.height = std::atoi(argv[4]);
   }
-  const int refine_limit = argc > 5 ? std::atoi(argv[5]) : 0;
   cv::setNumThreads(0);
   auto bundle = tod::LoadModelBundle(argv[1]);
   if (!bundle.ok()) {
@@ -62,57 +70,85 @@ int main(int argc, char** argv) {
     return 1;
   }
   const tod::FrameGeometry geometry = tod::GeometryForFrame(*bundle, synth.width, synth.height);
+  const tod::SizeFilter& filter = geometry.size_filter;
+  const bool filtered = bundle->params.size_filter && filter.enabled;
   const int layers = geometry.regions.num_layers();
-  std::vector<RegionRow> rows(static_cast<size_t>(layers));
+  const std::vector<Config> configs = {
+      {"paper", false, false}, {"+admission", true, false}, {"+local-max", true, true}};
+  std::vector<Totals> config_totals(configs.size());
+  std::vector<Totals> region_totals(static_cast<size_t>(layers));  // the model's configuration
+  std::vector<cv::Size> region_sizes(static_cast<size_t>(layers));
   for (int f = 0; f < frames; ++f) {
     const tod::Sample frame = tod::GenerateSynthFrame(synth, 1000 + static_cast<unsigned>(f), "b");
     const tod::OcclusionEdges oaocc =
         tod::ComputeOcclusionEdges(frame.image, geometry.regions, *bundle->edges,
                                    &bundle->occlusion, bundle->params.superpixels, true);
+    std::vector<double> frame_ms(configs.size(), 0.0);
     for (int k = 0; k < layers; ++k) {
       const cv::Mat1f map = tod::NormaliseToMax(tod::RegionEdgeMap(oaocc, geometry.regions, k));
+      const tod::Box region = tod::Intersect(geometry.regions.layers[k], oaocc.r1);
+      region_sizes[static_cast<size_t>(k)] = map.size();
       tod::EdgeBoxParams params = bundle->params.boxes;
       params.threads = 1;
-      params.refine_limit = refine_limit;
       params.stride_factor = bundle->params.multistride
                                  ? static_cast<float>(layers - k) / static_cast<float>(layers)
                                  : 1.f;
-      RegionRow& row = rows[static_cast<size_t>(k)];
-      row.width = map.cols;
-      row.height = map.rows;
-      row.stride_factor = params.stride_factor;
-      tod::EdgeBoxParams grid_only = params;
-      grid_only.refine = false;
-      const tod::Box region = tod::Intersect(geometry.regions.layers[k], oaocc.r1);
-      std::optional<tod::WindowAdmission> admission;
-      if (bundle->params.size_filter) admission.emplace(geometry.size_filter, region.y);
-      const tod::WindowAdmission* admit = admission ? &*admission : nullptr;
-      row.grid_ms.push_back(TimeMs([&] { tod::ScoreEdgeBoxes(map, grid_only, nullptr, admit); }));
-      tod::EdgeBoxStats stats;
-      row.full_ms.push_back(TimeMs([&] { tod::ScoreEdgeBoxes(map, params, &stats, admit); }));
-      row.stats.windows_visited += stats.windows_visited;
-      row.stats.windows_past_early_exit += stats.windows_past_early_exit;
-      row.stats.windows_nonzero += stats.windows_nonzero;
-      row.stats.scorings += stats.scorings;
-      row.stats.boxes_out += stats.boxes_out;
+      const tod::WindowAdmission admission(filter, region.y);
+      for (size_t c = 0; c < configs.size(); ++c) {
+        params.refine_local_maxima = configs[c].local_maxima;
+        tod::EdgeBoxStats stats;
+        const auto start = std::chrono::steady_clock::now();
+        const std::vector<tod::ScoredBox> boxes = tod::ScoreEdgeBoxes(
+            map, params, &stats, configs[c].admission && filtered ? &admission : nullptr);
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        long long kept = 0;
+        for (tod::ScoredBox b : boxes) {
+          b.box.y += region.y;
+          b.box.x += region.x;
+          kept += !filtered || filter.Keep(b.box);
+        }
+        frame_ms[c] += ms;
+        Add(config_totals[c], stats, kept);
+        if (configs[c].local_maxima == bundle->params.boxes.refine_local_maxima &&
+            configs[c].admission) {
+          Totals& r = region_totals[static_cast<size_t>(k)];
+          Add(r, stats, kept);
+          r.ms.push_back(ms);
+        }
+      }
     }
+    for (size_t c = 0; c < configs.size(); ++c) config_totals[c].ms.push_back(frame_ms[c]);
   }
-  std::printf("frame %dx%d, %d frames, refine_limit %d, one core; counts are per frame (mean)\n",
-              synth.width, synth.height, frames, refine_limit);
+  std::printf("frame %dx%d, %d frames, one core; counts per frame (mean), times median\n",
+              synth.width, synth.height, frames);
   std::printf(
-      "| region | map | stride x | windows | walks | non-zero | walks w/ refine | boxes | grid ms "
-      "| grid+refine+NMS ms |\n|---|---|---|---|---|---|---|---|---|---|\n");
-  double grid_total = 0, full_total = 0;
-  for (int k = 0; k < layers; ++k) {
-    const RegionRow& r = rows[static_cast<size_t>(k)];
-    const double g = Median(r.grid_ms), t = Median(r.full_ms);
-    grid_total += g;
-    full_total += t;
-    std::printf("| R%d | %dx%d | %.2f | %lld | %lld | %lld | %lld | %lld | %.1f | %.1f |\n", k + 1,
-                r.width, r.height, r.stride_factor, r.stats.windows_visited / frames,
-                r.stats.windows_past_early_exit / frames, r.stats.windows_nonzero / frames,
-                r.stats.scorings / frames, r.stats.boxes_out / frames, g, t);
+      "| configuration | ms | vs paper | windows scored | walks | refined | kept boxes |\n"
+      "|---|---|---|---|---|---|---|\n");
+  const double paper_ms = Median(config_totals[0].ms);
+  for (size_t c = 0; c < configs.size(); ++c) {
+    const Totals& t = config_totals[c];
+    const double ms = Median(t.ms);
+    std::printf("| %s | %.1f | %.2fx | %lld | %lld | %lld | %lld |\n", configs[c].name.c_str(), ms,
+                ms > 0 ? paper_ms / ms : 0.0, t.stats.windows_visited / frames,
+                t.stats.scorings / frames, t.stats.windows_refined / frames, t.kept / frames);
   }
-  std::printf("| all | | | | | | | | %.1f | %.1f |\n", grid_total, full_total);
+  std::printf("\nper region, the model's configuration (%s)\n",
+              bundle->params.boxes.refine_local_maxima ? "+local-max" : "+admission");
+  std::printf(
+      "| region | map | stride factor | windows scored | walks | refined | kept boxes | ms |\n"
+      "|---|---|---|---|---|---|---|---|\n");
+  for (int k = 0; k < layers; ++k) {
+    const Totals& r = region_totals[static_cast<size_t>(k)];
+    const cv::Size size = region_sizes[static_cast<size_t>(k)];
+    std::printf("| R%d | %dx%d | %.2f | %lld | %lld | %lld | %lld | %.1f |\n", k + 1, size.width,
+                size.height,
+                bundle->params.multistride
+                    ? static_cast<double>(layers - k) / static_cast<double>(layers)
+                    : 1.0,
+                r.stats.windows_visited / frames, r.stats.scorings / frames,
+                r.stats.windows_refined / frames, r.kept / frames, Median(r.ms));
+  }
   return 0;
 }

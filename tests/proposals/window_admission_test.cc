@@ -177,6 +177,12 @@ TEST(RefineLocalMaximaTest, RefinesExactlyTheGridLocalMaximaAndImprovesOnTheGrid
   EXPECT_EQ(stats.windows_nonzero, nonzero);
   EXPECT_EQ(stats.windows_refined, maxima);
   EXPECT_LT(maxima * 2, nonzero);  // most scoring windows have a better neighbour
+  // refine_limit then takes the best of the maxima.
+  EdgeBoxParams limited = params;
+  limited.refine_limit = 5;
+  EdgeBoxStats limited_stats;
+  ScoreEdgeBoxes(map, limited, &limited_stats);
+  EXPECT_EQ(limited_stats.windows_refined, 5);
   params.refine_local_maxima = false;
   const std::vector<ScoredBox> all = ScoreEdgeBoxes(map, params, &all_stats);
   EXPECT_LT(stats.scorings, all_stats.scorings);
