@@ -5,12 +5,13 @@
 //  10 X centre, 11 Y centre, 12 width, 13 height (full-image coordinates / actual image size),
 //  14-16 H/S/V standard deviation, 17-19 H/S/V contrast against the surround ring.
 //
-// Cost model (1800 x 620 region): construction is one pass over the edge map (sparse rows,
-// sparse_edge_map.h: 12 B per edge pixel) plus, unless a frame-wide ColourIntegrals is shared, one
-// pass over the colour crop (colour_integrals.h: about 25 B/pixel) instead of the former 250
-// B/pixel of full-resolution integral images. Per box: features 0-6 scan the box's rows (O(rows x
-// 64-column bands + edge pixels)); 14-19 are coarse-grid lookups plus scans of the strips (under
-// 4 px wide) around the cell-aligned part.
+// Cost model (1800 x 620 region): construction is one pass over the edge map (runs of one value
+// per row, sparse_edge_map.h: 12 B per run) plus, unless a frame-wide ColourIntegrals is shared,
+// one pass over the colour crop (colour_integrals.h: about 25 B/pixel) instead of the former 250
+// B/pixel of full-resolution integral images. Per box: features 0-6 scan the runs in the box's
+// rows (O(rows + runs in the box)); 14-19 are coarse-grid lookups plus scans of the strips (under
+// 4 px wide) around the cell-aligned part. ComputeAll visits the boxes in spatial order so that
+// these scans mostly hit the cache.
 //
 // Everything is exact except one documented approximation, on by default: the colour contrast
 // (17-19) of a LARGE box (grown box >= contrast_snap_min_area pixels, i.e. box ~64 x 64 and up,

@@ -77,9 +77,10 @@ class ColourIntegrals {
   const std::uint16_t* HistCorner(int line_y, int line_x) const;
   const double* MomentCorner(int line_y, int line_x) const;
   void AddAlignedHistogram(int ly0, int ly1, int lx0, int lx1, ColourHistogram& hist) const;
-  // Calls visit(code) for every pixel of rect, from the layout in which rect is contiguous.
+  // Calls visit(codes, n) for every row (rect at least as wide as high) or column (otherwise) of
+  // rect, top to bottom / left to right: the layout in which that line is contiguous.
   template <typename Visit>
-  void ForEachCode(const cv::Rect& rect, Visit&& visit) const;
+  void ForEachSpan(const cv::Rect& rect, Visit&& visit) const;
 
   void BuildPixels(const cv::Mat3b& bgr);
   void BuildCorners();

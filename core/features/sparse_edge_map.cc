@@ -3,14 +3,16 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 
 namespace tod {
 namespace {
 
-// Distinct positive values -> dense ids, by open addressing on the float's bit pattern (0 never
-// occurs as a key: only values > 0 get ids). A boundary has one constant value, so the previous
-// pixel's value is tried first.
+// Distinct non-zero values -> dense ids, by open addressing on the float's bit pattern (0 never
+// occurs as a key: +0 is skipped, -0 compares equal to it and is skipped too). A boundary has one
+// constant value, so the previous run's value is tried first.
 class ValueIdTable {
  public:
   explicit ValueIdTable(std::vector<float>& distinct) : distinct_(distinct) { Rehash(1024); }
@@ -68,132 +70,200 @@ Result<SparseEdgeMap> SparseEdgeMap::Build(const cv::Mat1f& region_map) {
   SparseEdgeMap out;
   out.size_ = region_map.size();
   const int rows = region_map.rows, cols = region_map.cols;
-  out.bands_ = (cols + kBandWidth - 1) >> kBandShift;
-  const std::size_t stride = static_cast<std::size_t>(rows) + 1;  // row offsets per band
-  // Pass 1, row-major: collect the entries (row y's are [row_major_start[y], ...[y + 1])) and
-  // count them per (band, row).
-  std::vector<Entry> row_major;
-  std::vector<int> row_major_start(rows + 1, 0);
-  std::vector<int> counts(static_cast<std::size_t>(out.bands_) * stride, 0);
-  ValueIdTable ids(out.distinct_values_);
+  out.index_stride_ = (cols >> kIndexShift) + 1;
+  out.row_start_.assign(static_cast<std::size_t>(rows) + 1, 0);
+  out.first_run_.resize(static_cast<std::size_t>(rows) * out.index_stride_);
+  std::vector<std::int64_t> pixels_of_id;  // for the exactness bound of the sums
+  ValueIdTable ids(out.values_);
   for (int y = 0; y < rows; ++y) {
     const float* row = region_map[y];
-    for (int x = 0; x < cols; ++x) {
+    const int row_begin = static_cast<int>(out.runs_.size());
+    for (int x = 0; x < cols;) {
       const float value = row[x];
-      if (value == 0.f) continue;  // NaN compares unequal, so it is caught below
+      if (value == 0.f) {  // NaN compares unequal, so it is caught below
+        ++x;
+        continue;
+      }
       if (!std::isfinite(value)) {
         return Status::InvalidArgument(
             "BoxFeatureExtractor: region_map contains NaN or infinity (at row " +
             std::to_string(y) + ", column " + std::to_string(x) + ")");
       }
-      row_major.push_back({x, value, value > 0.f ? ids.IdOf(value) : -1});
-      ++counts[static_cast<std::size_t>(x >> kBandShift) * stride + y];
+      // The run ends at the first pixel with another bit pattern (a NaN there stops it and is
+      // reported when the scan reaches it, as before).
+      const std::uint32_t key = std::bit_cast<std::uint32_t>(value);
+      int end = x + 1;
+      while (end < cols && std::bit_cast<std::uint32_t>(row[end]) == key) ++end;
+      const int id = ids.IdOf(value);
+      if (id == static_cast<int>(pixels_of_id.size())) pixels_of_id.push_back(0);
+      pixels_of_id[id] += end - x;
+      out.runs_.push_back({x, end, id});
+      x = end;
     }
-    row_major_start[y + 1] = static_cast<int>(row_major.size());
-  }
-  // Pass 2: offsets in band-major order, then a stable scatter (rows ascending, columns
-  // ascending within a row, as visited).
-  out.row_start_.resize(counts.size() + 1);
-  int total = 0;
-  for (std::size_t i = 0; i < counts.size(); ++i) {
-    out.row_start_[i] = total;
-    total += counts[i];
-  }
-  out.row_start_.back() = total;
-  out.entries_.resize(row_major.size());
-  std::vector<int>& next = counts;  // reused: next free slot of each (band, row)
-  std::copy(out.row_start_.begin(), out.row_start_.end() - 1, next.begin());
-  for (int y = 0; y < rows; ++y) {
-    for (int i = row_major_start[y]; i < row_major_start[y + 1]; ++i) {
-      const Entry& e = row_major[i];
-      out.entries_[next[static_cast<std::size_t>(e.column >> kBandShift) * stride + y]++] = e;
+    const int row_end = static_cast<int>(out.runs_.size());
+    out.row_start_[y + 1] = row_end;
+    int* index = out.first_run_.data() + static_cast<std::size_t>(y) * out.index_stride_;
+    for (int block = 0, r = row_begin; block < out.index_stride_; ++block) {
+      while (r < row_end && out.runs_[r].end <= (block << kIndexShift)) ++r;
+      index[block] = r;
     }
+  }
+
+  // Exactness of the sums (see the header). q = the smallest ulp among the values (a float of
+  // exponent e is a multiple of 2^(e - 23); subnormals of 2^-149); every value is then an integer
+  // number of q's, and if the map's total |M| is at most 2^53 q, no double partial sum of any
+  // subset in any order can round.
+  constexpr std::int64_t kExactLimit = std::int64_t{1} << std::numeric_limits<double>::digits;
+  constexpr int kFloatFraction = std::numeric_limits<float>::digits - 1;  // 23
+  constexpr int kMinQuantumExponent =
+      std::numeric_limits<float>::min_exponent - std::numeric_limits<float>::digits;  // -149
+  int quantum_exponent = std::numeric_limits<int>::max();
+  for (const float value : out.values_) {
+    quantum_exponent = std::min(quantum_exponent,
+                                std::max(std::ilogb(value) - kFloatFraction, kMinQuantumExponent));
+  }
+  out.sums_exact_ = true;
+  out.units_.resize(out.values_.size());
+  std::int64_t total_units = 0;  // sum of |M| / q over the map, checked against kExactLimit
+  for (std::size_t id = 0; id < out.values_.size() && out.sums_exact_; ++id) {
+    const double units = std::ldexp(static_cast<double>(out.values_[id]), -quantum_exponent);
+    const double magnitude = std::abs(units);
+    if (magnitude > static_cast<double>(kExactLimit) ||
+        static_cast<std::int64_t>(magnitude) > (kExactLimit - total_units) / pixels_of_id[id]) {
+      out.sums_exact_ = false;
+      break;
+    }
+    out.units_[id] = static_cast<std::int64_t>(units);  // an integer: no rounding
+    total_units += static_cast<std::int64_t>(magnitude) * pixels_of_id[id];
+  }
+  if (!out.sums_exact_) {
+    out.units_.clear();
+  } else if (!out.values_.empty()) {
+    out.quantum_ = std::ldexp(1.0, quantum_exponent);
   }
   return out;
+}
+
+int SparseEdgeMap::FirstRunAfter(int y, int x) const {
+  int r = first_run_[static_cast<std::size_t>(y) * index_stride_ + (x >> kIndexShift)];
+  const int end = row_start_[y + 1];
+  while (r < end && runs_[r].end <= x) ++r;  // at most the runs of one 16-column block
+  return r;
 }
 
 BoxEdgeStats SparseEdgeMap::Measure(const cv::Rect& box, const cv::Rect& inner) const {
   BoxEdgeStats stats;
   if (box.empty()) return stats;
-  // Occurrences per value id; all zero between calls (only touched ids are used and reset).
-  thread_local std::vector<int> counts;
+  // Pixels per value id in the box and in the centre sub-box; all zero between calls (only the
+  // touched ids are read and reset). touched has room for every id plus one scratch slot.
+  struct Tally {
+    int box;
+    int inner;
+  };
+  thread_local std::vector<Tally> tallies;
   thread_local std::vector<int> touched;
-  if (counts.size() < distinct_values_.size()) counts.resize(distinct_values_.size(), 0);
-  touched.clear();
+  if (tallies.size() < values_.size()) tallies.resize(values_.size(), Tally{0, 0});
+  if (touched.size() < values_.size() + 1) touched.resize(values_.size() + 1);
+  // Raw pointers in locals: the stores into the tallies could otherwise alias the members and
+  // force reloads in the inner loop.
+  Tally* const tally = tallies.data();
+  int* const touched_ids = touched.data();
+  const Run* const runs = runs_.data();
+  const int* const row_start = row_start_.data();
+  const int* const first_run = first_run_.data();
+  const std::size_t stride = static_cast<std::size_t>(index_stride_);
 
-  const std::size_t stride = static_cast<std::size_t>(size_.height) + 1;
   const int x0 = box.x, x1 = box.x + box.width;
   const int y0 = box.y, y1 = box.y + box.height;
-  // An empty sub-box gets an empty column range, so no entry is ever inside it.
-  const int ix0 = inner.empty() ? 0 : inner.x, ix1 = inner.empty() ? 0 : inner.x + inner.width;
-  const int iy0 = inner.y, iy1 = inner.y + inner.height;
-  // Local accumulators: counts[] is an int array, so the compiler could not keep stats.count in
-  // a register (possible aliasing).
+  // Rows outside the centre sub-box get an empty column range [0, 0): every run then has a
+  // non-positive inner length, clamped to 0 (runs start at column >= 0).
+  const bool has_inner = !inner.empty();
+  const int ix0 = has_inner ? inner.x : 0, ix1 = has_inner ? inner.x + inner.width : 0;
+  const int iy0 = has_inner ? inner.y : 0, iy1 = has_inner ? inner.y + inner.height : 0;
+  int num_touched = 0;
+  for (int y = y0; y < y1; ++y) {
+    const bool inner_row = y >= iy0 && y < iy1;
+    const int cx0 = inner_row ? ix0 : 0, cx1 = inner_row ? ix1 : 0;
+    const int end = row_start[y + 1];
+    int r = first_run[static_cast<std::size_t>(y) * stride + (x0 >> kIndexShift)];
+    while (r < end && runs[r].end <= x0) ++r;     // at most the runs of one index block
+    for (; r < end && runs[r].begin < x1; ++r) {  // runs ascend within a row
+      const Run run = runs[r];
+      Tally& t = tally[run.id];
+      // Branch-free "first time seen": always write, advance only for a new id.
+      touched_ids[num_touched] = run.id;
+      num_touched += t.box == 0;
+      t.box += std::min(run.end, x1) - std::max(run.begin, x0);
+      t.inner += std::max(0, std::min(run.end, cx1) - std::max(run.begin, cx0));
+    }
+  }
+
+  // Features 1-7 from the touched ids. Values are distinct, so (count descending, value
+  // ascending) is a strict order and the mode does not depend on the order of the ids.
+  const bool exact = sums_exact_;
+  std::int64_t units = 0, inner_units = 0;
+  int count = 0, inner_count = 0, mode_count = 0;
+  float mode_value = 0.f, max_value = 0.f;
+  for (int i = 0; i < num_touched; ++i) {
+    const int id = touched_ids[i];
+    const Tally t = tally[id];
+    tally[id] = Tally{0, 0};
+    if (exact) {
+      units += t.box * units_[id];
+      inner_units += t.inner * units_[id];
+    }
+    const float value = values_[id];
+    if (value <= 0.f) continue;  // negative values count in the sums only
+    count += t.box;
+    inner_count += t.inner;
+    max_value = std::max(max_value, value);
+    if (t.box > mode_count || (t.box == mode_count && value < mode_value)) {
+      mode_count = t.box;
+      mode_value = value;
+    }
+  }
+  stats.max_value = max_value;
+  stats.mode_value = mode_value;
+  stats.mode_count = mode_count;
+  stats.count = count;
+  stats.inner_count = inner_count;
+  if (exact) {
+    stats.sum = static_cast<double>(units) * quantum_;  // |units| <= 2^53: exact, as is * 2^k
+    stats.inner_sum = static_cast<double>(inner_units) * quantum_;
+  } else {
+    SequentialSums(box, inner, stats);
+  }
+  return stats;
+}
+
+void SparseEdgeMap::SequentialSums(const cv::Rect& box, const cv::Rect& inner,
+                                   BoxEdgeStats& stats) const {
+  // The original order: 64-column bands left to right, rows top to bottom, columns ascending,
+  // one double addition per pixel.
+  const int x0 = box.x, x1 = box.x + box.width;
+  const int y0 = box.y, y1 = box.y + box.height;
+  const bool has_inner = !inner.empty();
+  const int ix0 = has_inner ? inner.x : 0, ix1 = has_inner ? inner.x + inner.width : 0;
+  const int iy0 = has_inner ? inner.y : 0, iy1 = has_inner ? inner.y + inner.height : 0;
   double sum = 0.0, inner_sum = 0.0;
-  int count = 0, inner_count = 0;
-  int run_id = -1, run_length = 0;
-  auto flush_run = [&] {
-    if (run_length == 0) return;
-    if (counts[run_id] == 0) touched.push_back(run_id);
-    counts[run_id] += run_length;
-    run_length = 0;
-  };
   for (int band = x0 >> kBandShift; band <= (x1 - 1) >> kBandShift; ++band) {
-    const int band_x0 = band << kBandShift, band_x1 = band_x0 + kBandWidth;
-    const bool whole_band = x0 <= band_x0 && x1 >= band_x1;
-    const bool touches_inner = ix0 < band_x1 && ix1 > band_x0;
-    const int* row_start = row_start_.data() + band * stride;
+    const int bx0 = std::max(x0, band << kBandShift);
+    const int bx1 = std::min(x1, (band + 1) << kBandShift);
     for (int y = y0; y < y1; ++y) {
-      const bool inner_row = touches_inner && y >= iy0 && y < iy1;
-      const int end = row_start[y + 1];
-      for (int e = row_start[y]; e < end; ++e) {
-        const Entry& entry = entries_[e];
-        if (!whole_band) {
-          if (entry.column < x0) continue;
-          if (entry.column >= x1) break;  // columns ascend within a row
-        }
-        const bool positive = entry.id >= 0;
-        sum += entry.value;
-        count += positive;
-        if (inner_row && entry.column >= ix0 && entry.column < ix1) {
-          inner_sum += entry.value;
-          inner_count += positive;
-        }
-        // Runs of one value (a boundary segment along the row) are counted in a register and
-        // added at once: incrementing counts[id] per pixel serialises on the memory round trip.
-        if (positive) {
-          if (entry.id == run_id) {
-            ++run_length;
-          } else {
-            flush_run();
-            run_id = entry.id;
-            run_length = 1;
-          }
+      const bool inner_row = y >= iy0 && y < iy1;
+      const int end = row_start_[y + 1];
+      for (int r = FirstRunAfter(y, bx0); r < end && runs_[r].begin < bx1; ++r) {
+        const float value = values_[runs_[r].id];
+        const int c1 = std::min(runs_[r].end, bx1);
+        for (int c = std::max(runs_[r].begin, bx0); c < c1; ++c) {
+          sum += value;
+          if (inner_row && c >= ix0 && c < ix1) inner_sum += value;
         }
       }
     }
   }
-  flush_run();
   stats.sum = sum;
-  stats.count = count;
   stats.inner_sum = inner_sum;
-  stats.inner_count = inner_count;
-  if (touched.empty()) return stats;
-  int mode_id = touched.front();
-  float max_value = distinct_values_[mode_id];
-  for (const int id : touched) {
-    const float value = distinct_values_[id];
-    max_value = std::max(max_value, value);
-    if (counts[id] > counts[mode_id] ||
-        (counts[id] == counts[mode_id] && value < distinct_values_[mode_id])) {
-      mode_id = id;
-    }
-  }
-  stats.max_value = max_value;
-  stats.mode_value = distinct_values_[mode_id];
-  stats.mode_count = counts[mode_id];
-  for (const int id : touched) counts[id] = 0;
-  return stats;
 }
 
 }  // namespace tod

@@ -264,6 +264,27 @@ TEST(BoxFeaturesTest, ComputeAllMatchesCompute) {
   }
 }
 
+TEST(BoxFeaturesTest, ComputeAllOfScatteredBoxesKeepsInputOrder) {
+  // ComputeAll visits the boxes in a spatial order; rows must still follow the input order.
+  cv::RNG rng(99);
+  cv::Mat1f map(60, 200, 0.f);
+  for (int i = 0; i < 400; ++i) map(rng.uniform(0, 60), rng.uniform(0, 200)) = 0.1f * (i % 7 + 1);
+  cv::Mat3b bgr(60, 200);
+  rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
+  const BoxFeatureExtractor extractor(map, bgr, {10, 20}, {300, 100});
+  std::vector<ScoredBox> proposals;
+  for (int i = 0; i < 300; ++i) {
+    const int w = rng.uniform(1, 80), h = rng.uniform(1, 40);
+    proposals.push_back({{rng.uniform(-20, 220), rng.uniform(0, 90), w, h}, 0.001f * i});
+  }
+  const cv::Mat1f all = extractor.ComputeAll(proposals);
+  ASSERT_EQ(all.rows, static_cast<int>(proposals.size()));
+  for (int r = 0; r < all.rows; ++r) {
+    const BoxFeatureVector f = extractor.Compute(proposals[r].box, proposals[r].score);
+    for (int c = 0; c < kNumBoxFeatures; ++c) ASSERT_EQ(all(r, c), f[c]) << r << ", " << c;
+  }
+}
+
 TEST(BoxFeaturesTest, InvalidInputIsAnError) {
   const cv::Mat3b colour = Uniform(8, 8, {0, 0, 0});
   auto mismatch = BoxFeatureExtractor::Create(cv::Mat1f(8, 7, 0.f), colour, {0, 0}, {8, 8});
