@@ -5,12 +5,14 @@
 #include <map>
 #include <string>
 
+#include "core/base/heap_tuning.h"
 #include "server/config.h"
 #include "server/logging.h"
 #include "server/server_app.h"
 
 int main(int argc, char** argv) {
   tod::server::BlockServerSignals();
+  tod::RetainLargeAllocations();  // workers run the pipeline frame after frame
   CLI::App app{"tod_server: tiny obstacle discovery over gRPC and REST"};
   std::map<std::string, std::string> flags;
   std::string config_file;

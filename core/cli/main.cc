@@ -2,6 +2,7 @@
 #include <iostream>
 #include <map>
 
+#include "core/base/heap_tuning.h"
 #include "core/cli/commands.h"
 
 namespace tod::cli {
@@ -14,6 +15,7 @@ int Fail(const std::string& message) {
 }  // namespace tod::cli
 
 int main(int argc, char** argv) {
+  tod::RetainLargeAllocations();  // detect / train / eval run the pipeline frame after frame
   CLI::App app{"tod: tiny obstacle discovery (occlusion-aware multilayer regression)"};
   app.require_subcommand(1);
   std::map<CLI::App*, tod::cli::Runner> runners;

@@ -1,0 +1,22 @@
+#include "core/base/heap_tuning.h"
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+namespace tod {
+
+bool RetainLargeAllocations() {
+#if defined(__GLIBC__)
+  // 32 MiB is glibc's largest mmap threshold on 64-bit (HEAP_MAX_SIZE / 2): every per-region
+  // table of a 2048-wide frame is below it. The trim threshold keeps freed heap tops.
+  constexpr int kMmapThreshold = 32 * 1024 * 1024;
+  constexpr int kTrimThreshold = 1024 * 1024 * 1024;
+  return mallopt(M_MMAP_THRESHOLD, kMmapThreshold) == 1 &&
+         mallopt(M_TRIM_THRESHOLD, kTrimThreshold) == 1;
+#else
+  return true;
+#endif
+}
+
+}  // namespace tod
