@@ -43,10 +43,11 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--threads", args->train.threads, "worker threads (0 = all cores)");
   cmd->add_flag("--no-size-filter", args->no_size_filter, "switch the box size filter off");
   cmd->add_option("--refine-limit", args->train.params.boxes.refine_limit,
-                  "refine only the N best windows per region (approximation; 0 = exact, all)")
+                  "refine at most the N best grid local maxima per region (0 = all of them)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--refine-all", args->refine_all,
-                "refine every scoring window, as the paper (default: grid local maxima only)");
+                "refine every scoring window, as the paper (default: the 5000 best grid local "
+                "maxima per region)");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,
@@ -56,7 +57,10 @@ Runner AddTrainCommand(CLI::App& app) {
     if (!options.sed_model.empty() && options.edge_source != "sed") options.edge_source = "sed";
     options.regressor.num_trees = args->trees;
     options.params.size_filter = !args->no_size_filter;
-    if (args->refine_all) options.params.boxes.refine_local_maxima = false;
+    if (args->refine_all) {
+      options.params.boxes.refine_local_maxima = false;
+      options.params.boxes.refine_limit = 0;
+    }
     options.progress = [](const std::string& line) { std::cerr << "train: " << line << "\n"; };
     auto bundle = TrainModel(options);
     if (!bundle.ok()) return Fail(bundle.status().message());

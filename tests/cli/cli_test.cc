@@ -56,6 +56,7 @@ TEST_F(CliTest, TrainWroteACompleteManifestWithItsOwnEvalNumbers) {
   EXPECT_EQ(m["edge_source"], "pixel_forest");
   EXPECT_TRUE(m["params"].contains("boxes"));
   EXPECT_EQ(m["params"]["boxes"]["refine_local_maxima"], true);  // the default refinement
+  EXPECT_EQ(m["params"]["boxes"]["refine_limit"], 5000);
   EXPECT_GT(m["training"]["ordr_samples"].get<int>(), 100);
   ASSERT_TRUE(m["eval"].contains("regression"));
   EXPECT_TRUE(m["eval"]["regression"].contains("BP+Fusion@4"));

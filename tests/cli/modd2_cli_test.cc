@@ -40,6 +40,7 @@ TEST(Modd2Cli, TrainAndEvalOnMarineScenes) {
   EXPECT_EQ(manifest["training"]["format"], "modd2");
   // --refine-all: the paper's refinement of every scoring window, recorded with the model.
   EXPECT_EQ(manifest["params"]["boxes"]["refine_local_maxima"], false);
+  EXPECT_EQ(manifest["params"]["boxes"]["refine_limit"], 0);
 
   std::tie(code, out) =
       Shell(tod + " eval --data " + (dir / "modd2").string() + " --format modd2 --model " +
