@@ -187,4 +187,25 @@ TEST_F(CliTest, SynthIsDeterministicForASeed) {
   EXPECT_EQ(files, 3);  // image, labelIds, instanceIds
 }
 
+TEST_F(CliTest, ShippedDefaultModelLoadsAndDetects) {
+  // The committed bundle (models/default) passes every load check and runs on a frame of
+  // another size (regions and size filter scale with the frame).
+  const fs::path model = fs::path(tod::testing_env::SourceDir()) / "models" / "default";
+  CommandResult run = Shell(tod_ + " synth --out " + (out_ / "d").string() +
+                            " --train 1 --test 0 --seed 5 --width 512 --height 256");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::string image;
+  for (const auto& e : fs::recursive_directory_iterator(out_ / "d" / "leftImg8bit"))
+    if (e.path().extension() == ".png") image = e.path().string();
+  ASSERT_FALSE(image.empty());
+  run = Shell(tod_ + " detect --model " + model.string() + " --out " + (out_ / "o").string() + " " +
+              image);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const fs::path json = out_ / "o" / (fs::path(image).stem().string() + ".json");
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["width"], 512);
+  EXPECT_FALSE(j["proposals"].empty());
+}
+
 }  // namespace
