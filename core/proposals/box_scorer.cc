@@ -1,10 +1,11 @@
 #include "core/proposals/box_scorer.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
-#include "core/proposals/edge_orientation.h"
+#include "core/proposals/fresh_buffer.h"
 #include "core/proposals/refinement_schedule.h"
 
 namespace tod {
@@ -18,8 +19,21 @@ EdgeGroupParams GroupParamsOf(const EdgeBoxParams& p) {
 }
 
 // NaN or infinite edge values would poison orientations, sums and finally the score order:
-// they count as "no edge".
+// they count as "no edge". Maps are normally finite already; then the map itself is used (the
+// scorer only reads it during construction), which spares the copy - unless it is a view into a
+// larger matrix: the orientation's smoothing would read the parent's pixels beyond its border
+// where the copy has reflected ones.
 cv::Mat1f FiniteCopy(const cv::Mat1f& map) {
+  std::uint32_t non_finite = 0;
+  for (int r = 0; r < map.rows && non_finite == 0; ++r) {
+    const float* row = map[r];
+    // NaN and +-inf are the floats with an all-ones exponent; the branch-free integer test
+    // vectorises.
+    for (int c = 0; c < map.cols; ++c) {
+      non_finite |= (std::bit_cast<std::uint32_t>(row[c]) & 0x7f800000u) == 0x7f800000u;
+    }
+  }
+  if (non_finite == 0 && !map.isSubmatrix()) return map;
   cv::Mat1f out = map.clone();
   for (int r = 0; r < out.rows; ++r) {
     float* row = out[r];
@@ -42,10 +56,12 @@ BoxScorer::BoxScorer(const cv::Mat1f& edge_map, const EdgeBoxParams& params, int
       refine_ratio_((1.f - params.alpha) / (1.f + params.alpha)) {
   auto tables = std::make_shared<Tables>();
   Tables& t = *tables;
-  t.groups = BuildEdgeGroups(edge_map, ComputeEdgeOrientation(edge_map, params.edge_min_mag),
-                             GroupParamsOf(params));
+  // Every table below only changes at edge pixels (a few % of the map): they are all built from
+  // the edge-pixel lists the grouping makes (t.groups.edges, pixels > edge_min_mag as in the
+  // score), and orientation is only computed at the pixels grouping reads it at.
+  t.groups = BuildEdgeGroups(edge_map, GroupParamsOf(params));
   BuildIntegralImages(edge_map, t);
-  t.bound = ContainmentBound(t.groups, edge_map, params.edge_min_mag);
+  t.bound = ContainmentBound(t.groups, t.groups.edges);
   BuildRunIndexes(t);
   t.norm.resize(static_cast<size_t>(width_ + height_) / 2 + 2);
   t.norm[0] = 0.f;  // a box narrower than 3 x 3 pixels has no inner part to normalise: score 0
@@ -81,47 +97,63 @@ void BoxScorer::BuildWalkGraph(Tables& t) {
   ring_size_ = n;
 }
 
-void BoxScorer::BuildIntegralImages(const cv::Mat1f& edge_map, Tables& t) {
+void BoxScorer::BuildIntegralImages(const cv::Mat1f& /*edge_map*/, Tables& t) {
+  // Column by column: integral = left column + running sum of this column's values (the group
+  // magnitude at each anchor; M at each edge pixel). Between two edge pixels (anchors are edge
+  // pixels too) the running sums are constant, so the column is a vectorisable add of the left
+  // column and a constant. Exact: each entry is still left + running sum, with the running sum
+  // accumulated over the same non-zero terms in the same (row) order; the zeros it skips would
+  // leave a non-negative double sum unchanged.
+  const EdgePixels& edges = t.groups.edges;
   const size_t stride = static_cast<size_t>(height_) + 1;
   const size_t n = (static_cast<size_t>(width_) + 1) * stride;
-  // Per-pixel values first (column-major, offset by one), then the running sums.
-  t.anchor_mag_integral.assign(n, 0.0);
-  t.edge_mag_integral.assign(n, 0.0);
-  for (int s = 1; s <= t.groups.count(); ++s) {
-    t.anchor_mag_integral[(t.groups.anchor_x[s] + 1) * stride + t.groups.anchor_y[s] + 1] +=
-        t.groups.magnitude[s];
-  }
-  for (int r = 0; r < height_; ++r) {
-    const float* e = edge_map[r];
-    for (int c = 0; c < width_; ++c) {
-      if (e[c] > params_.edge_min_mag) t.edge_mag_integral[(c + 1) * stride + r + 1] = e[c];
-    }
-  }
-  for (std::vector<double>* integral : {&t.anchor_mag_integral, &t.edge_mag_integral}) {
-    std::vector<double>& I = *integral;
-    for (int c = 1; c <= width_; ++c) {
-      double column_sum = 0.0;
-      for (int r = 1; r <= height_; ++r) {
-        column_sum += I[c * stride + r];
-        I[c * stride + r] = I[(c - 1) * stride + r] + column_sum;
+  ReserveFresh(t.anchor_mag_integral, n);
+  ReserveFresh(t.edge_mag_integral, n);
+  Append(t.anchor_mag_integral, stride);  // column 0: zero
+  Append(t.edge_mag_integral, stride);
+  for (int c = 1; c <= width_; ++c) {
+    double* anchor = Append(t.anchor_mag_integral, stride);  // row 0: zero
+    double* edge = Append(t.edge_mag_integral, stride);
+    const double* anchor_left = anchor - stride;
+    const double* edge_left = edge - stride;
+    double anchor_sum = 0.0, edge_sum = 0.0;
+    int r = 1;
+    const auto fill_to = [&](int end) {
+      for (; r < end; ++r) {
+        anchor[r] = anchor_left[r] + anchor_sum;
+        edge[r] = edge_left[r] + edge_sum;
+      }
+    };
+    for (int i = edges.col_begin[c - 1]; i < edges.col_begin[c]; ++i) {
+      const int row = edges.col_row[i];
+      fill_to(row + 1);  // rows before the first integral row that includes the pixel
+      edge_sum += static_cast<double>(edges.col_value[i]);
+      const int s = t.groups.ids(row, c - 1);
+      if (s > 0 && t.groups.anchor_x[s] == c - 1 && t.groups.anchor_y[s] == row) {
+        anchor_sum += static_cast<double>(t.groups.magnitude[s]);
       }
     }
+    fill_to(height_ + 1);
   }
 }
 
 namespace {
 
-// Appends the runs of non-zero ids of one line (values at line[i * step], i < length) to `runs`,
-// plus the sentinel, and sets first_run[i] (at first_run[i * 1]) to the index of the first run
-// ending at or after i.
-template <typename Run>
-void IndexLine(const int* line, int length, int step, std::vector<Run>& runs, int* first_run) {
+// Appends the runs of non-zero ids of one line to `runs`, plus the sentinel, and sets
+// first_run[i] (i < length) to the index of the first run ending at or after i. The line is
+// given by its edge pixels (positions `at` ascending; ids of all other pixels are 0):
+// id_at(i) is the id at position i, `ends` scratch reused across lines.
+template <typename Run, typename IdAt>
+void IndexLine(const int* at, int count, int length, const IdAt& id_at, std::vector<Run>& runs,
+               std::vector<int>& ends, int* first_run) {
   const int base = static_cast<int>(runs.size());
-  std::vector<int> ends;
-  for (int i = 0; i < length; ++i) {
-    const int id = line[static_cast<size_t>(i) * step];
+  ends.clear();
+  for (int k = 0; k < count; ++k) {
+    const int i = at[k];
+    const int id = id_at(i);
     if (id <= 0) continue;
-    if (i > 0 && line[static_cast<size_t>(i - 1) * step] == id) {
+    // The previous pixel continues the last run when that run ends there with the same id.
+    if (!ends.empty() && ends.back() == i - 1 && runs.back().group == id) {
       ends.back() = i;
       continue;
     }
@@ -129,28 +161,37 @@ void IndexLine(const int* line, int length, int step, std::vector<Run>& runs, in
     ends.push_back(i);
   }
   runs.push_back(Run{std::numeric_limits<int>::max(), 0});
-  size_t k = 0;
-  for (int i = 0; i < length; ++i) {
-    while (k < ends.size() && ends[k] < i) ++k;
-    first_run[i] = base + static_cast<int>(k);
+  // first_run is constant between run ends: [previous end + 1, end k] -> run k.
+  int i = 0;
+  for (size_t k = 0; k < ends.size(); ++k) {
+    std::fill(first_run + i, first_run + ends[k] + 1, base + static_cast<int>(k));
+    i = ends[k] + 1;
   }
+  std::fill(first_run + i, first_run + length, base + static_cast<int>(ends.size()));
 }
 
 }  // namespace
 
 void BoxScorer::BuildRunIndexes(Tables& t) {
-  const cv::Mat1i& ids = t.groups.ids;  // continuous: a cv::Mat1i we built ourselves
-  t.row_first_run.assign(static_cast<size_t>(width_) * height_, 0);
-  t.col_first_run.assign(static_cast<size_t>(width_) * height_, 0);
+  const cv::Mat1i& ids = t.groups.ids;
+  const EdgePixels& edges = t.groups.edges;
+  ReserveFresh(t.row_first_run, static_cast<size_t>(width_) * height_);
+  ReserveFresh(t.col_first_run, static_cast<size_t>(width_) * height_);
   t.row_runs.clear();
   t.col_runs.clear();
+  std::vector<int> ends;
   for (int r = 0; r < height_; ++r) {
-    IndexLine(ids[r], width_, 1, t.row_runs, &t.row_first_run[static_cast<size_t>(r) * width_]);
+    const int* row = ids[r];
+    const int begin = edges.row_begin[r];
+    IndexLine(
+        edges.row_col.data() + begin, edges.row_begin[r + 1] - begin, width_,
+        [row](int c) { return row[c]; }, t.row_runs, ends, Append(t.row_first_run, width_));
   }
-  const int step = static_cast<int>(ids.step1());
   for (int c = 0; c < width_; ++c) {
-    IndexLine(ids[0] + c, height_, step, t.col_runs,
-              &t.col_first_run[static_cast<size_t>(c) * height_]);
+    const int begin = edges.col_begin[c];
+    IndexLine(
+        edges.col_row.data() + begin, edges.col_begin[c + 1] - begin, height_,
+        [&ids, c](int r) { return ids(r, c); }, t.col_runs, ends, Append(t.col_first_run, height_));
   }
 }
 

@@ -3,51 +3,35 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/proposals/fresh_buffer.h"
+
 namespace tod {
-namespace {
-
-// Running 2-D sums in place over a column-major (width + 1) x (height + 1) array whose first row
-// and column are zero; unsigned overflow wraps, which keeps rectangle differences exact as long
-// as every true rectangle sum stays below 2^32.
-template <typename T, typename Get>
-void Accumulate(std::vector<T>& cells, int width, int height, Get get) {
-  const size_t stride = static_cast<size_t>(height) + 1;
-  for (int c = 1; c <= width; ++c) {
-    for (int r = 1; r <= height; ++r) {
-      const size_t i = c * stride + r;
-      get(cells[i], cells[i - 1], cells[i - stride], cells[i - stride - 1]);
-    }
-  }
-}
-
-}  // namespace
-
 ContainmentBound::ContainmentBound(const EdgeGroups& groups, const cv::Mat1f& edge_map,
-                                   float edge_min_mag) {
-  const int width = edge_map.cols, height = edge_map.rows;
+                                   float edge_min_mag)
+    : ContainmentBound(groups, FindEdgePixels(edge_map, edge_min_mag)) {}
+
+ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& edges) {
+  const int width = edges.cols, height = edges.rows;
   const int n = groups.count();
   stride_ = static_cast<size_t>(height) + 1;
-  // Bounding boxes of the groups.
+  // Bounding boxes of the groups: every grouped pixel is an edge pixel, and the column-major
+  // list meets a group's columns in ascending order.
   std::vector<int> x0(n + 1, width), x1(n + 1, -1), y0(n + 1, height), y1(n + 1, -1);
-  for (int r = 0; r < height; ++r) {
-    const int* ids = groups.ids[r];
-    for (int c = 0; c < width; ++c) {
-      const int s = ids[c];
+  for (int c = 0; c < width; ++c) {
+    for (int i = edges.col_begin[c]; i < edges.col_begin[c + 1]; ++i) {
+      const int r = edges.col_row[i];
+      const int s = groups.ids(r, c);
       if (s <= 0) continue;
-      x0[s] = std::min(x0[s], c);
-      x1[s] = std::max(x1[s], c);
+      if (x1[s] < 0) x0[s] = c;
+      x1[s] = c;
       y0[s] = std::min(y0[s], r);
       y1[s] = std::max(y1[s], r);
     }
   }
   double total_magnitude = 0.0, total_edge = 0.0;
   for (int s = 1; s <= n; ++s) total_magnitude += groups.magnitude[s];
-  for (int r = 0; r < height; ++r) {
-    const float* e = edge_map[r];
-    for (int c = 0; c < width; ++c) {
-      if (e[c] > edge_min_mag) total_edge += e[c];
-    }
-  }
+  // Row-major, the order of a full scan of the map: the same double sum.
+  for (const float e : edges.row_value) total_edge += e;
   // The largest power of two that keeps every sum (each rounded-up group adds < 1 unit) below
   // 2^32, capped where the resolution stops mattering.
   const double capacity = 4294967295.0 - static_cast<double>(n) - 1.0;
@@ -58,32 +42,68 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const cv::Mat1f& ed
   // The exact score is a handful of double operations on values up to the totals.
   margin_ = 1e-9 * (largest + 1.0);
 
+  // Both integrals are built column by column (see fresh_buffer.h) as left column + running sum
+  // of this column, in modular uint32 arithmetic: the ring's sums do not depend on the order of
+  // the additions, so the values equal those of any other summation order (e.g. the 2-D
+  // recurrence here = pixel + up + left - up_left).
   const size_t size = (static_cast<size_t>(width) + 1) * stride_;
-  cells_.assign(size, Cell{});
-  edges_.assign(size, 0u);
+  // Group magnitudes at the four bounding-box corners, bucketed by integral column.
+  struct CornerValue {
+    int row = 0, corner = 0;
+    std::uint32_t value = 0;
+  };
+  std::vector<int> corner_begin(static_cast<size_t>(width) + 2, 0);
   for (int s = 1; s <= n; ++s) {
-    const auto q = static_cast<std::uint32_t>(std::ceil(groups.magnitude[s] * scale));
-    const int xs[4] = {x0[s], x1[s], x0[s], x1[s]};
-    const int ys[4] = {y0[s], y0[s], y1[s], y1[s]};
-    for (int k = 0; k < 4; ++k) cells_[Index(ys[k] + 1, xs[k] + 1)].corner[k] += q;
+    corner_begin[x0[s] + 2] += 2;  // corners 0 and 2 in integral column x0 + 1
+    corner_begin[x1[s] + 2] += 2;  // corners 1 and 3 in integral column x1 + 1
   }
-  for (int r = 0; r < height; ++r) {
-    const float* e = edge_map[r];
-    for (int c = 0; c < width; ++c) {
-      if (e[c] > edge_min_mag) {
-        edges_[Index(r + 1, c + 1)] = static_cast<std::uint32_t>(std::floor(e[c] * scale));
-      }
+  for (int c = 0; c <= width; ++c) corner_begin[c + 1] += corner_begin[c];
+  std::vector<CornerValue> corners(static_cast<size_t>(corner_begin[width + 1]));
+  {
+    std::vector<int> next(corner_begin.begin(), corner_begin.end() - 1);
+    for (int s = 1; s <= n; ++s) {
+      const auto q = static_cast<std::uint32_t>(std::ceil(groups.magnitude[s] * scale));
+      const int xs[4] = {x0[s], x1[s], x0[s], x1[s]};
+      const int ys[4] = {y0[s], y0[s], y1[s], y1[s]};
+      for (int k = 0; k < 4; ++k) corners[next[xs[k] + 1]++] = {ys[k] + 1, k, q};
     }
   }
-  Accumulate(cells_, width, height,
-             [](Cell& here, const Cell& up, const Cell& left, const Cell& up_left) {
-               for (int k = 0; k < 4; ++k)
-                 here.corner[k] += up.corner[k] + left.corner[k] - up_left.corner[k];
-             });
-  Accumulate(edges_, width, height,
-             [](std::uint32_t& here, std::uint32_t up, std::uint32_t left, std::uint32_t up_left) {
-               here += up + left - up_left;
-             });
+  ReserveFresh(cells_, size);
+  Append(cells_, stride_);  // column 0: zero
+  for (int c = 1; c <= width; ++c) {
+    Cell* here = Append(cells_, stride_);  // zeroed, cache-resident: scatter, then sum in place
+    const Cell* left = here - stride_;
+    for (int i = corner_begin[c]; i < corner_begin[c + 1]; ++i) {
+      here[corners[i].row].corner[corners[i].corner] += corners[i].value;
+    }
+    std::uint32_t sum0 = 0, sum1 = 0, sum2 = 0, sum3 = 0;
+    for (int r = 1; r <= height; ++r) {
+      sum0 += here[r].corner[0];
+      sum1 += here[r].corner[1];
+      sum2 += here[r].corner[2];
+      sum3 += here[r].corner[3];
+      here[r].corner[0] = left[r].corner[0] + sum0;
+      here[r].corner[1] = left[r].corner[1] + sum1;
+      here[r].corner[2] = left[r].corner[2] + sum2;
+      here[r].corner[3] = left[r].corner[3] + sum3;
+    }
+  }
+  // The edge integral only changes at edge pixels: between two of them a column is the left
+  // column plus a constant.
+  ReserveFresh(edges_, size);
+  Append(edges_, stride_);  // column 0: zero
+  for (int c = 1; c <= width; ++c) {
+    std::uint32_t* here = Append(edges_, stride_);  // row 0: zero
+    const std::uint32_t* left = here - stride_;
+    std::uint32_t sum = 0;
+    int r = 1;
+    for (int i = edges.col_begin[c - 1]; i < edges.col_begin[c]; ++i) {
+      const int row = edges.col_row[i] + 1;  // the first integral row that includes the pixel
+      for (; r < row; ++r) here[r] = left[r] + sum;
+      sum += static_cast<std::uint32_t>(std::floor(edges.col_value[i] * scale));
+    }
+    for (; r <= height; ++r) here[r] = left[r] + sum;
+  }
 }
 
 }  // namespace tod

@@ -31,6 +31,8 @@ class ContainmentBound {
   ContainmentBound() = default;
   // edge_map: finite values; edge pixels are those > edge_min_mag (as in the score).
   ContainmentBound(const EdgeGroups& groups, const cv::Mat1f& edge_map, float edge_min_mag);
+  // The same from the map's edge pixels (groups.edges when the threshold is the score's).
+  ContainmentBound(const EdgeGroups& groups, const EdgePixels& edges);
 
   // Group magnitude at the four bounding-box corners: top-left, top-right, bottom-left,
   // bottom-right; one cache line fetch serves all four integrals.

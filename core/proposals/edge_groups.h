@@ -14,6 +14,27 @@ struct EdgeGroupParams {
   float gamma = 2.f;             // affinity exponent
 };
 
+// The edge pixels (M > a threshold) of a map in both scan orders, with their values, found in one
+// pass. Edge pixels are a few % of an OLP map, so every per-map table that only changes at edge
+// pixels (grouping, statistics, integral images, run indexes) is built from these lists instead
+// of from full passes over the map.
+struct EdgePixels {
+  int rows = 0, cols = 0;
+  // Row r holds entries [row_begin[r], row_begin[r + 1]): columns row_col[i] (ascending), values
+  // row_value[i]. Size rows + 1.
+  std::vector<int> row_begin;
+  std::vector<int> row_col;
+  std::vector<float> row_value;
+  // Column c holds entries [col_begin[c], col_begin[c + 1]): rows col_row[i] (ascending), values
+  // col_value[i]. Size cols + 1.
+  std::vector<int> col_begin;
+  std::vector<int> col_row;
+  std::vector<float> col_value;
+};
+
+// Pixels with map > min_magnitude (NaN never is).
+EdgePixels FindEdgePixels(const cv::Mat1f& map, float min_magnitude);
+
 // Group ids are 1..count(); id 0 means "no group" (not an edge pixel, the 1-pixel map border, or
 // a dissolved pixel with no grouped neighbour). Index 0 of every per-group vector is unused.
 struct EdgeGroups {
@@ -29,6 +50,9 @@ struct EdgeGroups {
   std::vector<int> affinity_begin;
   std::vector<int> affinity_target;
   std::vector<float> affinity_value;
+  // The map's edge pixels (M > edge_min_mag) the groups were built from; every grouped pixel is
+  // one of them (border pixels and dissolved pixels without a grouped neighbour have id 0).
+  EdgePixels edges;
 
   int count() const { return magnitude.empty() ? 0 : static_cast<int>(magnitude.size()) - 1; }
 };
@@ -42,5 +66,8 @@ cv::Mat1i GroupEdgePixels(const cv::Mat1f& edge_map, const cv::Mat1f& orientatio
 // for groups that come within a 5x5 neighbourhood of each other. Maps must have equal size.
 EdgeGroups BuildEdgeGroups(const cv::Mat1f& edge_map, const cv::Mat1f& orientation,
                            const EdgeGroupParams& params);
+// The same with the orientation of ComputeEdgeOrientation(edge_map) computed here, at the edge
+// pixels only (the only pixels grouping reads it at); bit-identical result.
+EdgeGroups BuildEdgeGroups(const cv::Mat1f& edge_map, const EdgeGroupParams& params);
 
 }  // namespace tod

@@ -21,6 +21,35 @@ cv::Mat1f TriangleSmooth(const cv::Mat1f& map) {
 
 float Sign(float v) { return v > 0.f ? 1.f : (v < 0.f ? -1.f : 0.f); }
 
+// theta from the three second derivatives, shared by the dense and the per-pixel paths.
+float ThetaOf(float oxx, float oxy, float oyy) {
+  constexpr float kPi = std::numbers::pi_v<float>;
+  float t = std::atan(oyy * Sign(-oxy) / (oxx + 1e-5f));
+  t = std::fmod(t, kPi);  // MATLAB mod: result takes the sign of the divisor
+  if (t < 0.f) t += kPi;
+  if (t >= kPi) t -= kPi;
+  return t;
+}
+
+// DerivativeX / DerivativeY of a map given as value(r, c), at one pixel: the same expressions
+// with the same border rules, so the values are bit-identical to the dense maps'.
+template <typename Value>
+float DerivativeXAt(const Value& value, int w, int r, int c) {
+  if (w < 2) return 0.f;
+  if (c == 0) return value(r, 1) - value(r, 0);
+  if (c == w - 1) return value(r, w - 1) - value(r, w - 2);
+  return 0.5f * (value(r, c + 1) - value(r, c - 1));
+}
+
+template <typename Value>
+float DerivativeYAt(const Value& value, int h, int r, int c) {
+  if (h < 2) return 0.f;
+  const int up = r == 0 ? 0 : r - 1;
+  const int down = r == h - 1 ? h - 1 : r + 1;
+  const float scale = (r == 0 || r == h - 1) ? 1.f : 0.5f;
+  return scale * (value(down, c) - value(up, c));
+}
+
 }  // namespace
 
 cv::Mat1f DerivativeX(const cv::Mat1f& map) {
@@ -57,6 +86,17 @@ cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map) {
   return ComputeEdgeOrientation(edge_map, -std::numeric_limits<float>::infinity());
 }
 
+cv::Mat1f SmoothForOrientation(const cv::Mat1f& edge_map) { return TriangleSmooth(edge_map); }
+
+float OrientationAt(const cv::Mat1f& smoothed, int r, int c) {
+  const int w = smoothed.cols, h = smoothed.rows;
+  const auto s = [&smoothed](int y, int x) { return smoothed(y, x); };
+  const auto ox = [&](int y, int x) { return DerivativeXAt(s, w, y, x); };
+  const auto oy = [&](int y, int x) { return DerivativeYAt(s, h, y, x); };
+  return ThetaOf(DerivativeXAt(ox, w, r, c), DerivativeXAt(oy, w, r, c),
+                 DerivativeYAt(oy, h, r, c));
+}
+
 cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map, float min_magnitude) {
   if (edge_map.empty()) return {};
   const cv::Mat1f smoothed = TriangleSmooth(edge_map);
@@ -65,16 +105,11 @@ cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map, float min_magnitude)
   const cv::Mat1f oxx = DerivativeX(ox);
   const cv::Mat1f oxy = DerivativeX(oy);
   const cv::Mat1f oyy = DerivativeY(oy);
-  constexpr float kPi = std::numbers::pi_v<float>;
   cv::Mat1f theta(edge_map.size(), 0.f);
   for (int r = 0; r < edge_map.rows; ++r) {
     for (int c = 0; c < edge_map.cols; ++c) {
       if (!(edge_map(r, c) > min_magnitude)) continue;
-      float t = std::atan(oyy(r, c) * Sign(-oxy(r, c)) / (oxx(r, c) + 1e-5f));
-      t = std::fmod(t, kPi);  // MATLAB mod: result takes the sign of the divisor
-      if (t < 0.f) t += kPi;
-      if (t >= kPi) t -= kPi;
-      theta(r, c) = t;
+      theta(r, c) = ThetaOf(oxx(r, c), oxy(r, c), oyy(r, c));
     }
   }
   return theta;

@@ -16,6 +16,14 @@ cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map);
 // orientations of edge pixels only, and the per-pixel arctangent is the costly part.
 cv::Mat1f ComputeEdgeOrientation(const cv::Mat1f& edge_map, float min_magnitude);
 
+// The two halves of ComputeEdgeOrientation for callers that need theta at a few pixels only
+// (edge grouping reads it at edge pixels, a few % of a map): the smoothed map, and theta at one
+// pixel of it from its 5x5 neighbourhood. OrientationAt(SmoothForOrientation(m), r, c) is
+// bit-identical to ComputeEdgeOrientation(m)(r, c): it evaluates the same float expressions of
+// the same smoothed values, border rules included, without the five full derivative maps.
+cv::Mat1f SmoothForOrientation(const cv::Mat1f& edge_map);
+float OrientationAt(const cv::Mat1f& smoothed, int r, int c);
+
 // Central differences in the interior, one-sided differences on the first / last column (row);
 // a single column (row) has zero derivative. Exposed for tests.
 cv::Mat1f DerivativeX(const cv::Mat1f& map);
