@@ -78,15 +78,13 @@ std::vector<size_t> BestByGridScore(const std::vector<ScoreWindow>& hits,
   return candidates;
 }
 
-// Of `candidates` (grid order), the windows whose grid score no grid neighbour of the same shape
-// (one stride away in x, y or both) exceeds.
+// Indexes (grid order) of the hits whose grid score no grid neighbour of the same shape (one
+// stride away in x, y or both) exceeds.
 std::vector<size_t> LocalMaxima(const std::vector<ScoreWindow>& hits, const std::vector<int>& rows,
                                 const std::vector<size_t>& column_begin,
-                                const std::vector<GridColumn>& columns,
-                                const std::vector<size_t>& candidates) {
+                                const std::vector<GridColumn>& columns) {
   std::vector<size_t> kept;
-  kept.reserve(candidates.size() / 4);
-  size_t column = 0;
+  kept.reserve(hits.size() / 4);
   // Best score among the hits of column c at grid rows [row - 1, row + 1].
   const auto best_near = [&](size_t c, int row) {
     const auto first = rows.begin() + static_cast<std::ptrdiff_t>(column_begin[c]);
@@ -97,17 +95,17 @@ std::vector<size_t> LocalMaxima(const std::vector<ScoreWindow>& hits, const std:
     }
     return best;
   };
-  for (const size_t i : candidates) {
-    while (column_begin[column + 1] <= i) ++column;
-    const int row = rows[i];
-    float best = best_near(column, row);
-    if (column > 0 && columns[column - 1].shape == columns[column].shape) {
-      best = std::max(best, best_near(column - 1, row));
+  for (size_t column = 0; column < columns.size(); ++column) {
+    const bool left = column > 0 && columns[column - 1].shape == columns[column].shape;
+    const bool right =
+        column + 1 < columns.size() && columns[column + 1].shape == columns[column].shape;
+    for (size_t i = column_begin[column]; i < column_begin[column + 1]; ++i) {
+      const int row = rows[i];
+      float best = best_near(column, row);
+      if (left) best = std::max(best, best_near(column - 1, row));
+      if (right) best = std::max(best, best_near(column + 1, row));
+      if (hits[i].score >= best) kept.push_back(i);
     }
-    if (column + 1 < columns.size() && columns[column + 1].shape == columns[column].shape) {
-      best = std::max(best, best_near(column + 1, row));
-    }
-    if (hits[i].score >= best) kept.push_back(i);
   }
   return kept;
 }
@@ -130,6 +128,20 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
     const int x_end = scorer.width() - shapes[s].width + shapes[s].stride_x;
     for (int x = 0; x < x_end; x += shapes[s].stride_x) columns.push_back({s, x});
   }
+  // Window tops the size filter admits for a column at x of a shape: from the column's clamped
+  // width and how far refinement can move the window's sides.
+  const auto admitted_tops_of = [&](int x, const WindowShape& shape) {
+    const int c0 = std::min(x, scorer.width() - 1);
+    const int c1 = std::min(x + shape.width, scorer.width() - 1);
+    const RefinementSchedule schedule = ScheduleRefinement(shape.height, c1 - c0, refine_ratio);
+    const RefinementReach reach =
+        params.refine ? RefinementReach{schedule.row_reach, schedule.col_reach} : RefinementReach{};
+    return admission->AdmittedTops(c1 - c0 + 1, shape.height + 1, reach, scorer.height());
+  };
+  std::vector<RowRanges> shape_tops;  // per shape, for its unclamped columns
+  if (admission != nullptr) {
+    for (const WindowShape& shape : shapes) shape_tops.push_back(admitted_tops_of(0, shape));
+  }
 
   // Pass 1: score every grid window (steps 4-6).
   const size_t column_chunks = (columns.size() + kColumnsPerChunk - 1) / kColumnsPerChunk;
@@ -140,19 +152,15 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
     const long long walks_before = s.past_early_exit();
     for (size_t i = c * kColumnsPerChunk; i < end; ++i) {
       const WindowShape& shape = shapes[columns[i].shape];
-      RowRanges tops;
-      if (admission != nullptr) {
-        // The column's clamped width, and how far refinement can move its sides.
-        const int c0 = std::min(columns[i].x, s.width() - 1);
-        const int c1 = std::min(columns[i].x + shape.width, s.width() - 1);
-        const RefinementSchedule schedule = ScheduleRefinement(shape.height, c1 - c0, refine_ratio);
-        const RefinementReach reach = params.refine
-                                          ? RefinementReach{schedule.row_reach, schedule.col_reach}
-                                          : RefinementReach{};
-        tops = admission->AdmittedTops(c1 - c0 + 1, shape.height + 1, reach, s.height());
+      // Tops admitted for this column: the shape's own unless the column is clamped narrower.
+      const RowRanges* tops = admission != nullptr ? &shape_tops[columns[i].shape] : nullptr;
+      RowRanges clamped_tops;
+      if (tops != nullptr && columns[i].x + shape.width > s.width() - 1) {
+        clamped_tops = admitted_tops_of(columns[i].x, shape);
+        tops = &clamped_tops;
       }
-      out.windows += s.ScoreColumn(columns[i].x, shape.width, shape.height, shape.stride_y,
-                                   admission != nullptr ? &tops : nullptr, out.hits, &out.rows);
+      out.windows += s.ScoreColumn(columns[i].x, shape.width, shape.height, shape.stride_y, tops,
+                                   out.hits, &out.rows);
       out.hit_end.push_back(static_cast<int>(out.hits.size()));
     }
     out.walks = s.past_early_exit() - walks_before;
@@ -167,6 +175,7 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
     hits.insert(hits.end(), chunk.hits.begin(), chunk.hits.end());
     hit_rows.insert(hit_rows.end(), chunk.rows.begin(), chunk.rows.end());
     chunk.hits = {};
+    chunk.rows = {};
   }
   stats.windows_nonzero = static_cast<long long>(hits.size());
 
@@ -174,10 +183,12 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
   // matters more than anything an order by score bounds could skip - then NMS (step 8).
   if (params.refine) {
     // Local maxima first, so that refine_limit picks the best of them.
-    std::vector<size_t> chosen(hits.size());
-    std::iota(chosen.begin(), chosen.end(), size_t{0});
+    std::vector<size_t> chosen;
     if (params.refine_local_maxima) {
-      chosen = LocalMaxima(hits, hit_rows, column_begin, columns, chosen);
+      chosen = LocalMaxima(hits, hit_rows, column_begin, columns);
+    } else {
+      chosen.resize(hits.size());
+      std::iota(chosen.begin(), chosen.end(), size_t{0});
     }
     chosen = BestByGridScore(hits, std::move(chosen), params.refine_limit);
     const size_t chunks = (chosen.size() + kRefinementsPerChunk - 1) / kRefinementsPerChunk;

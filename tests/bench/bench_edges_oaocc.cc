@@ -2,26 +2,21 @@
 // 1800x620 textured synthetic crop. Prints a table of medians; nothing is asserted.
 #include <algorithm>
 #include <cstdio>
-#include <ctime>
 #include <functional>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "core/edges/occlusion_classifier.h"
 #include "core/edges/sticky_superpixels.h"
+#include "tests/bench/bench_clock.h"
 
 namespace {
+
+using tod::bench::ThreadCpuMs;
 
 using tod::OcclusionClassifier;
 using tod::StickySuperpixelParams;
 using tod::Superpixels;
-
-// Thread CPU time: the machine is shared, and wall time would mostly measure the neighbours.
-double ThreadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 double MedianMs(int runs, const std::function<void()>& work) {
   std::vector<double> ms;

@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <functional>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -10,8 +9,11 @@
 
 #include "core/edges/edge_channels.h"
 #include "core/edges/edge_source.h"
+#include "tests/bench/bench_clock.h"
 
 namespace {
+
+using tod::bench::ThreadCpuMs;
 
 // A crop with a grey background, a darker lower half and many coloured blobs, plus noise.
 tod::EdgeTrainingFrame MakeScene(int width, int height, int seed) {
@@ -35,12 +37,6 @@ tod::EdgeTrainingFrame MakeScene(int width, int height, int seed) {
   noisy += noise;
   noisy.convertTo(frame.image, CV_8UC3);
   return frame;
-}
-
-double ThreadCpuMs() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) * 1e3 + static_cast<double>(now.tv_nsec) / 1e6;
 }
 
 double Median(std::vector<double> values) {

@@ -3,7 +3,6 @@
 // large boxes, with the default (large boxes snapped, see box_features.h) and the exact colour
 // contrast. Prints medians of thread CPU time (robust when the machine is shared) and of wall
 // time; asserts nothing.
-#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -16,19 +15,16 @@
 #include <vector>
 
 #include "core/features/box_features.h"
+#include "tests/bench/bench_clock.h"
 
 namespace {
+
+using tod::bench::ThreadCpuMs;
 
 struct Timing {
   double cpu_ms = 0.0;
   double wall_ms = 0.0;
 };
-
-double ThreadCpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
 
 // Median CPU and wall time of `repeats` runs of fn.
 Timing MedianTiming(int repeats, const std::function<void()>& fn) {

@@ -5,7 +5,6 @@
 //   bench_pipeline_frame MODEL_DIR [REPEATS=5] [WIDTH=2048 HEIGHT=1024]
 // The frame is a synthetic scene (seeded); OpenCV's own threading is off, as in the server's
 // workers, so every number is one core's work.
-#include <time.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -18,17 +17,9 @@
 #include "core/base/heap_tuning.h"
 #include "core/data/synth.h"
 #include "core/pipeline/detector.h"
+#include "tests/bench/bench_clock.h"
 
-namespace {
-
-// CPU time of this thread: robust when neighbours share the machine (wall time is not).
-double ThreadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
-
-}  // namespace
+using tod::bench::ThreadCpuMs;
 
 int main(int argc, char** argv) {
   if (argc < 2) {

@@ -16,7 +16,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -26,14 +25,11 @@
 
 #include "core/proposals/box_scorer.h"
 #include "core/proposals/edge_box_scorer.h"
+#include "tests/bench/bench_clock.h"
 
 namespace {
 
-double ThreadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
-}
+using tod::bench::ThreadCpuMs;
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
