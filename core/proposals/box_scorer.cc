@@ -60,7 +60,7 @@ BoxScorer::BoxScorer(const cv::Mat1f& edge_map, const EdgeBoxParams& params, int
   // the edge-pixel lists the grouping makes (t.groups.edges, pixels > edge_min_mag as in the
   // score), and orientation is only computed at the pixels grouping reads it at.
   t.groups = BuildEdgeGroups(edge_map, GroupParamsOf(params));
-  BuildIntegralImages(edge_map, t);
+  BuildIntegralImages(t);
   t.bound = ContainmentBound(t.groups, t.groups.edges);
   BuildRunIndexes(t);
   t.norm.resize(static_cast<size_t>(width_ + height_) / 2 + 2);
@@ -97,7 +97,7 @@ void BoxScorer::BuildWalkGraph(Tables& t) {
   ring_size_ = n;
 }
 
-void BoxScorer::BuildIntegralImages(const cv::Mat1f& /*edge_map*/, Tables& t) {
+void BoxScorer::BuildIntegralImages(Tables& t) {
   // Column by column: integral = left column + running sum of this column's values (the group
   // magnitude at each anchor; M at each edge pixel). Between two edge pixels (anchors are edge
   // pixels too) the running sums are constant, so the column is a vectorisable add of the left

@@ -101,7 +101,8 @@ class BoxScorer {
   // next to a box that scored, the bound rarely rejects them, and its loads cost more than the
   // walks it saves (measured with bench_proposals_olp).
   void ScoreImpl(ScoreWindow& window, float bar, bool use_bound);
-  void BuildIntegralImages(const cv::Mat1f& edge_map, Tables& t);
+  // From the edge-pixel lists of t.groups (all that changes the sums).
+  void BuildIntegralImages(Tables& t);
   void BuildRunIndexes(Tables& t);
   void BuildWalkGraph(Tables& t);
   // Sum over the inclusive rectangle of a column-major (width+1) x (height+1) integral image.
