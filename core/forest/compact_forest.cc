@@ -27,7 +27,7 @@ CompactForest CompactForest::Build(const std::vector<ForestNode>& nodes,
     return packed;
   }
   packed.feature_bits_ = feature_bits;
-  packed.feature_mask_ = (std::uint32_t{1} << feature_bits) - 1;
+  packed.num_features_ = num_features;
   packed.nodes_.resize(nodes.size());
   packed.leaf_values_.assign(nodes.size(), 0.f);
   for (std::size_t i = 0; i < nodes.size(); ++i) {
@@ -49,19 +49,46 @@ CompactForest CompactForest::Build(const std::vector<ForestNode>& nodes,
 }
 
 void CompactForest::AccumulateLeafValues(const float* const* rows, int count, double* sums) const {
+  // The proposal regressors have 20 features (5 bits), the pixel edge forest 49 (6 bits).
+  switch (feature_bits_) {
+    case 1:
+      return AccumulateCopied<1>(rows, count, sums);
+    case 2:
+      return AccumulateCopied<2>(rows, count, sums);
+    case 3:
+      return AccumulateCopied<3>(rows, count, sums);
+    case 4:
+      return AccumulateCopied<4>(rows, count, sums);
+    case 5:
+      return AccumulateCopied<5>(rows, count, sums);
+    case 6:
+      return AccumulateCopied<6>(rows, count, sums);
+    case 7:
+      return AccumulateCopied<7>(rows, count, sums);
+    default:  // wider rows: the same walk with the width read at run time
+      return AccumulateCopied<0>(rows, count, sums);
+  }
+}
+
+template <int kFeatureBits>
+void CompactForest::AccumulateCopied(const float* const* rows, int count, double* sums) const {
+  if (count <= 0) return;
+  const int bits = kFeatureBits > 0 ? kFeatureBits : feature_bits_;
+  const std::size_t stride = std::size_t{1} << bits;
+  const std::uint32_t mask = (std::uint32_t{1} << bits) - 1;
+  // Whole lane groups: the spare lanes of a partial last group walk rows of zeros (harmless:
+  // their leaves are never added).
+  const int padded_rows = (count + kLanes - 1) / kLanes * kLanes;
+  std::vector<float> copied(static_cast<std::size_t>(padded_rows) * stride, 0.f);
+  for (int r = 0; r < count; ++r) {
+    std::copy_n(rows[r], num_features_, copied.data() + static_cast<std::size_t>(r) * stride);
+  }
   const PackedNode* const nodes = nodes_.data();
-  const int shift = feature_bits_;
-  const std::uint32_t mask = feature_mask_;
   for (const std::uint32_t root : roots_) {
     for (int first = 0; first < count; first += kLanes) {
-      // A partial last group repeats its last row in the spare lanes and ignores them.
-      const int used = std::min(kLanes, count - first);
-      std::array<const float*, kLanes> lane_row;
+      const float* const group = copied.data() + static_cast<std::size_t>(first) * stride;
       std::array<std::uint32_t, kLanes> at;
-      for (int k = 0; k < kLanes; ++k) {
-        lane_row[k] = rows[first + std::min(k, used - 1)];
-        at[k] = root;
-      }
+      at.fill(root);
       // A split always moves to a later node and a leaf never moves, so extra steps are
       // harmless and the walk is over when a step moves no lane. That test costs as much as
       // the step itself, so it is made only on every kStepsPerCheck-th step.
@@ -69,8 +96,8 @@ void CompactForest::AccumulateLeafValues(const float* const* rows, int count, do
         bool moved = false;
         for (int k = 0; k < kLanes; ++k) {
           const PackedNode node = nodes[at[k]];
-          const std::uint32_t next =
-              (node.word >> shift) + (lane_row[k][node.word & mask] > node.threshold ? 1u : 0u);
+          const float x = group[k * stride + (node.word & mask)];
+          const std::uint32_t next = (node.word >> bits) + (x > node.threshold ? 1u : 0u);
           if (check) moved |= next != at[k];
           at[k] = next;
         }
@@ -79,6 +106,7 @@ void CompactForest::AccumulateLeafValues(const float* const* rows, int count, do
       do {
         for (int s = 1; s < kStepsPerCheck; ++s) step(false);
       } while (step(true));
+      const int used = std::min(kLanes, count - first);
       for (int k = 0; k < used; ++k) sums[first + k] += leaf_values_[at[k]];
     }
   }

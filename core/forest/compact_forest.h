@@ -8,7 +8,11 @@
 //    the descent needs no leaf test: the inner loop is branch-free;
 //  * rows are walked tree-major over blocks (one tree for all rows of a block, so the tree stays
 //    in cache) and several rows descend in lock-step, which turns one long chain of dependent
-//    loads into independent chains the CPU overlaps.
+//    loads into independent chains the CPU overlaps;
+//  * the rows of a block are first copied side by side at a power-of-two stride that is also the
+//    feature field's width, so with that width as a compile-time constant a lane's feature is
+//    one load at a constant offset from the group's base: no per-lane row pointer (which left
+//    too few registers and was reloaded from the stack on every step) and no variable shifts.
 // Per row, leaf values are still added in tree order into a double starting at 0, exactly as
 // RandomForest::Predict does, so the results are bit-identical.
 #pragma once
@@ -48,8 +52,13 @@ class CompactForest {
   };
   static_assert(sizeof(PackedNode) == 8);
 
+  // The walk over rows copied to a stride of 2^kFeatureBits floats (see above); kFeatureBits 0
+  // reads the width from feature_bits_ (rows of more than 128 features).
+  template <int kFeatureBits>
+  void AccumulateCopied(const float* const* rows, int count, double* sums) const;
+
   int feature_bits_ = 0;
-  std::uint32_t feature_mask_ = 0;
+  int num_features_ = 0;
   std::vector<PackedNode> nodes_;
   std::vector<float> leaf_values_;  // per node; meaningful for leaves only
   std::vector<std::uint32_t> roots_;

@@ -209,6 +209,38 @@ TEST(BatchPrediction, LoadedForestPredictsTheSameBatch) {
   EXPECT_EQ(copy.PredictBatch(test.x), forest.PredictBatch(test.x));
 }
 
+// The batch walk copies rows to a stride fixed per feature-count class (1, 2, 3-4, ... 65-128
+// features) and walks wider rows through pointers: each width must give Predict's floats, with
+// the highest feature indices in use (the target depends on the first and the last column).
+TEST(BatchPrediction, EveryFeatureWidthMatchesPredict) {
+  for (const int cols : {1, 2, 3, 5, 20, 49, 64, 65, 128, 129, 200}) {
+    std::mt19937 gen(40 + static_cast<unsigned>(cols));
+    std::uniform_real_distribution<float> uniform(0.f, 1.f);
+    const auto make = [&](int rows) {
+      Data d{cv::Mat1f(rows, cols), std::vector<float>(rows)};
+      for (int r = 0; r < rows; ++r) {
+        for (int c = 0; c < cols; ++c) d.x(r, c) = uniform(gen);
+        d.y[r] = std::sin(5.f * d.x(r, 0)) + 2.f * d.x(r, cols - 1);
+      }
+      return d;
+    };
+    const Data train = make(300);
+    ForestParams p;
+    p.num_trees = 4;
+    p.max_features = cols;
+    p.min_leaf_size = 1;
+    p.threads = 1;
+    const RandomForest forest = RandomForest::Train(train.x, train.y, p);
+    ASSERT_EQ(forest.num_trees(), 4) << cols;
+    const Data test = make(77);  // not a multiple of the lane count
+    const std::vector<float> batch = forest.PredictBatch(test.x);
+    ASSERT_EQ(batch.size(), 77u) << cols;
+    int mismatches = 0;
+    for (int r = 0; r < test.x.rows; ++r) mismatches += batch[r] != forest.Predict(test.x[r]);
+    EXPECT_EQ(mismatches, 0) << cols << " features";
+  }
+}
+
 TEST(BatchPrediction, SubsetRejectsBadInput) {
   const RandomForest forest = ThreeTreeForest();
   const cv::Mat1f rows(4, 2, 0.f);
