@@ -28,7 +28,7 @@ class GreedyNms {
     int next = -1;  // next entry in the same cell
   };
   struct Grid {
-    long long cell = 1;  // side in pixels
+    int cell_shift = 1;  // side in pixels = 2^cell_shift
     int cols = 0, rows = 0;
     std::vector<int> head;  // first entry per cell (column-major), -1 = none
     int CellX(long long offset) const;

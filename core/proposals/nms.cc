@@ -10,8 +10,8 @@
 // With 10 000 kept boxes the grid turns the per-candidate scan of thousands of same-size boxes
 // into a few cells.
 #include <algorithm>
+#include <bit>
 #include <cmath>
-#include <numeric>
 
 #include "core/proposals/edge_box_scorer.h"
 #include "core/proposals/greedy_nms.h"
@@ -46,11 +46,15 @@ bool GreedyNms::Offer(const ScoredBox& box) {
   return true;
 }
 
+// Cells are a power of two wide, so a cell index is a shift: these run a dozen times per
+// candidate, and 64-bit divisions made up a good part of the search. Any monotone map from
+// offsets to cells keeps the search complete (a kept box within the radius lies in a cell
+// between the cells of the radius' ends).
 int GreedyNms::Grid::CellX(long long offset) const {
-  return static_cast<int>(std::clamp<long long>(offset / cell, 0, cols - 1));
+  return static_cast<int>(std::min<long long>(std::max(offset, 0LL) >> cell_shift, cols - 1));
 }
 int GreedyNms::Grid::CellY(long long offset) const {
-  return static_cast<int>(std::clamp<long long>(offset / cell, 0, rows - 1));
+  return static_cast<int>(std::min<long long>(std::max(offset, 0LL) >> cell_shift, rows - 1));
 }
 
 bool GreedyNms::Suppressed(const Box& candidate) const {
@@ -62,16 +66,26 @@ bool GreedyNms::Suppressed(const Box& candidate) const {
   const int bin = BinOf(candidate);
   const long long rx = static_cast<long long>(radius_factor_ * candidate.w) + 2;
   const long long ry = static_cast<long long>(radius_factor_ * candidate.h) + 2;
-  for (int b = std::max(0, bin - 1); b <= std::min(kBinCount - 1, bin + 1); ++b) {
+  const auto suppressed_in_cell = [&](const Grid& g, int gx, int gy) {
+    for (int e = g.head[static_cast<size_t>(gx) * g.rows + gy]; e >= 0; e = entries_[e].next) {
+      if (BoxIoU(candidate, entries_[e].box) > threshold_) return true;
+    }
+    return false;
+  };
+  // Most candidates are suppressed, and most often by a kept box of about their own size and
+  // place: the candidate's own bin and cell are searched first, which ends most searches early.
+  // (The answer does not depend on the order.)
+  for (const int b : {bin, bin - 1, bin + 1}) {
+    if (b < 0 || b >= kBinCount) continue;
     const Grid& g = grids_[b];
     if (g.head.empty()) continue;
+    const int own_x = g.CellX(candidate.x - min_x_), own_y = g.CellY(candidate.y - min_y_);
+    if (suppressed_in_cell(g, own_x, own_y)) return true;
     const int gx0 = g.CellX(candidate.x - rx - min_x_), gx1 = g.CellX(candidate.x + rx - min_x_);
     const int gy0 = g.CellY(candidate.y - ry - min_y_), gy1 = g.CellY(candidate.y + ry - min_y_);
     for (int gx = gx0; gx <= gx1; ++gx) {
       for (int gy = gy0; gy <= gy1; ++gy) {
-        for (int e = g.head[static_cast<size_t>(gx) * g.rows + gy]; e >= 0; e = entries_[e].next) {
-          if (BoxIoU(candidate, entries_[e].box) > threshold_) return true;
-        }
+        if ((gx != own_x || gy != own_y) && suppressed_in_cell(g, gx, gy)) return true;
       }
     }
   }
@@ -98,16 +112,20 @@ int GreedyNms::BinOf(const Box& b) const {
   return static_cast<int>(std::clamp(bin, 0.0, static_cast<double>(kBinCount - 1)));
 }
 
-// Cells of about half the side of a square box of the bin's smallest area: a candidate then
-// scans two or three cells per axis.
+// Cells of about half the side of a square box of the bin's smallest area (rounded down to a
+// power of two): a candidate then scans two to four cells per axis.
 GreedyNms::Grid GreedyNms::MakeGrid(int bin) const {
   Grid g;
-  g.cell = std::max(2LL, static_cast<long long>(0.5 * std::exp(0.5 * bin * log_step_)));
+  const long long wanted =
+      std::max(2LL, static_cast<long long>(0.5 * std::exp(0.5 * bin * log_step_)));
+  g.cell_shift = std::bit_width(static_cast<unsigned long long>(wanted)) - 1;  // round down
   const long long span_x = static_cast<long long>(max_x_) - min_x_ + 1;
   const long long span_y = static_cast<long long>(max_y_) - min_y_ + 1;
-  while ((span_x / g.cell + 1) * (span_y / g.cell + 1) > kMaxCells) g.cell *= 2;
-  g.cols = static_cast<int>(span_x / g.cell + 1);
-  g.rows = static_cast<int>(span_y / g.cell + 1);
+  while (((span_x >> g.cell_shift) + 1) * ((span_y >> g.cell_shift) + 1) > kMaxCells) {
+    ++g.cell_shift;
+  }
+  g.cols = static_cast<int>((span_x >> g.cell_shift) + 1);
+  g.rows = static_cast<int>((span_y >> g.cell_shift) + 1);
   g.head.assign(static_cast<size_t>(g.cols) * g.rows, -1);
   return g;
 }
@@ -128,12 +146,18 @@ std::vector<ScoredBox> NonMaximumSuppression(std::vector<ScoredBox> boxes, float
     first = false;
   }
   GreedyNms nms(iou_threshold, max_boxes, min_x, min_y, max_x, max_y);
-  // Order: score descending, then input order (deterministic under ties). Sorting all boxes is
-  // wasteful when max_boxes is reached early, so select and sort growing chunks from the front.
-  std::vector<int> order(boxes.size());
-  std::iota(order.begin(), order.end(), 0);
-  const auto before = [&boxes](int a, int b) {
-    return boxes[a].score > boxes[b].score || (boxes[a].score == boxes[b].score && a < b);
+  // Order: score descending, then input order (deterministic under ties). The keys carry their
+  // score so that comparisons need no lookup into `boxes` (a cache miss each in a large set).
+  // Sorting all boxes is wasteful when max_boxes is reached early, so select and sort growing
+  // chunks from the front.
+  struct Key {
+    float score;
+    int index;
+  };
+  std::vector<Key> order(boxes.size());
+  for (size_t i = 0; i < boxes.size(); ++i) order[i] = {boxes[i].score, static_cast<int>(i)};
+  const auto before = [](const Key& a, const Key& b) {
+    return a.score > b.score || (a.score == b.score && a.index < b.index);
   };
   size_t done = 0;
   size_t chunk = std::max<size_t>(1024, 4 * static_cast<size_t>(max_boxes));
@@ -143,7 +167,7 @@ std::vector<ScoredBox> NonMaximumSuppression(std::vector<ScoredBox> boxes, float
     const auto last = first_it + static_cast<std::ptrdiff_t>(take);
     if (last != order.end()) std::nth_element(first_it, last, order.end(), before);
     std::sort(first_it, last, before);
-    for (auto it = first_it; it != last && !nms.full(); ++it) nms.Offer(boxes[*it]);
+    for (auto it = first_it; it != last && !nms.full(); ++it) nms.Offer(boxes[it->index]);
     done += take;
     chunk *= 2;
   }
