@@ -82,18 +82,17 @@ void BoxScorer::BuildWalkGraph(Tables& t) {
     nodes_[g].magnitude = t.groups.magnitude[g];
   }
   // A walk weight is at most 1, so an edge with affinity < 0.05 never passes the 0.05 cut.
-  t.walk_edge_begin.assign(n + 1, 0);
   t.walk_edges.clear();
   for (int g = 0; g < n; ++g) {
+    nodes_[g].edge_begin = static_cast<int>(t.walk_edges.size());
     for (int k = t.groups.affinity_begin[g]; k < t.groups.affinity_begin[g + 1]; ++k) {
       if (t.groups.affinity_value[k] >= kMinPathWeight) {
         t.walk_edges.push_back({t.groups.affinity_target[k], t.groups.affinity_value[k]});
       }
     }
-    t.walk_edge_begin[g + 1] = static_cast<int>(t.walk_edges.size());
+    nodes_[g].edge_end = static_cast<int>(t.walk_edges.size());
   }
-  walk_.assign(n, WalkEntry{});
-  queue_.assign(n, 0);  // a slot is queued at most once at a time
+  queue_.assign(n, 0);  // a group is queued at most once at a time
   ring_size_ = n;
 }
 
@@ -139,14 +138,12 @@ void BoxScorer::BuildIntegralImages(Tables& t) {
 
 namespace {
 
-// Appends the runs of non-zero ids of one line to `runs`, plus the sentinel, and sets
-// first_run[i] (i < length) to the index of the first run ending at or after i. The line is
-// given by its edge pixels (positions `at` ascending; ids of all other pixels are 0):
-// id_at(i) is the id at position i, `ends` scratch reused across lines.
+// Appends the runs of non-zero ids of one line to `runs`, plus the sentinel, and sets ends[k] to
+// the last position of run k of the line. The line is given by its edge pixels (positions `at`
+// ascending; ids of all other pixels are 0): id_at(i) is the id at position i.
 template <typename Run, typename IdAt>
-void IndexLine(const int* at, int count, int length, const IdAt& id_at, std::vector<Run>& runs,
-               std::vector<int>& ends, int* first_run) {
-  const int base = static_cast<int>(runs.size());
+void RunsOfLine(const int* at, int count, const IdAt& id_at, std::vector<Run>& runs,
+                std::vector<int>& ends) {
   ends.clear();
   for (int k = 0; k < count; ++k) {
     const int i = at[k];
@@ -161,7 +158,11 @@ void IndexLine(const int* at, int count, int length, const IdAt& id_at, std::vec
     ends.push_back(i);
   }
   runs.push_back(Run{std::numeric_limits<int>::max(), 0});
-  // first_run is constant between run ends: [previous end + 1, end k] -> run k.
+}
+
+// Sets first_run[i] (i < length) to the index of the first run of the line (runs numbered from
+// `base`, ending at `ends`) that ends at or after i: constant over [previous end + 1, end k].
+void FillFirstRun(const std::vector<int>& ends, int base, int length, int* first_run) {
   int i = 0;
   for (size_t k = 0; k < ends.size(); ++k) {
     std::fill(first_run + i, first_run + ends[k] + 1, base + static_cast<int>(k));
@@ -175,23 +176,48 @@ void IndexLine(const int* at, int count, int length, const IdAt& id_at, std::vec
 void BoxScorer::BuildRunIndexes(Tables& t) {
   const cv::Mat1i& ids = t.groups.ids;
   const EdgePixels& edges = t.groups.edges;
-  ReserveFresh(t.row_first_run, static_cast<size_t>(width_) * height_);
-  ReserveFresh(t.col_first_run, static_cast<size_t>(width_) * height_);
   t.row_runs.clear();
   t.col_runs.clear();
   std::vector<int> ends;
+  // Rows first: their runs, and each run's end bucketed by column (counting sort), for the
+  // column sweep below.
+  std::vector<int> row_first(static_cast<size_t>(height_));  // row r's first run at column c
+  std::vector<int> run_row, run_end;                         // per row run (not sentinels)
   for (int r = 0; r < height_; ++r) {
-    const int* row = ids[r];
     const int begin = edges.row_begin[r];
-    IndexLine(
-        edges.row_col.data() + begin, edges.row_begin[r + 1] - begin, width_,
-        [row](int c) { return row[c]; }, t.row_runs, ends, Append(t.row_first_run, width_));
+    const int* row = ids[r];
+    row_first[r] = static_cast<int>(t.row_runs.size());
+    RunsOfLine(
+        edges.row_col.data() + begin, edges.row_begin[r + 1] - begin,
+        [row](int c) { return row[c]; }, t.row_runs, ends);
+    for (const int end : ends) {
+      run_row.push_back(r);
+      run_end.push_back(end);
+    }
   }
+  std::vector<int> end_begin(static_cast<size_t>(width_) + 1, 0);  // rows whose run ends at c:
+  for (const int end : run_end) ++end_begin[end + 1];              // [end_begin[c], end_begin[c+1])
+  for (int c = 0; c < width_; ++c) end_begin[c + 1] += end_begin[c];
+  std::vector<int> end_row(run_row.size());
+  {
+    std::vector<int> next(end_begin.begin(), end_begin.end() - 1);
+    for (size_t k = 0; k < run_row.size(); ++k) end_row[next[run_end[k]]++] = run_row[k];
+  }
+  // Column by column: the column's own runs, then both indexes of the column. row_first holds,
+  // per row, the first run ending at or after c (it advances past the runs that end at c once
+  // column c is written): the same values as a row-by-row fill, written sequentially.
+  ReserveFresh(t.first_run, static_cast<size_t>(width_) * height_);
+  std::vector<int> col_first(static_cast<size_t>(height_));
   for (int c = 0; c < width_; ++c) {
     const int begin = edges.col_begin[c];
-    IndexLine(
-        edges.col_row.data() + begin, edges.col_begin[c + 1] - begin, height_,
-        [&ids, c](int r) { return ids(r, c); }, t.col_runs, ends, Append(t.col_first_run, height_));
+    const int base = static_cast<int>(t.col_runs.size());
+    RunsOfLine(
+        edges.col_row.data() + begin, edges.col_begin[c + 1] - begin,
+        [&ids, c](int r) { return ids(r, c); }, t.col_runs, ends);
+    FillFirstRun(ends, base, height_, col_first.data());
+    FirstRuns* out = Append(t.first_run, static_cast<size_t>(height_));
+    for (int r = 0; r < height_; ++r) out[r] = FirstRuns{row_first[r], col_first[r]};
+    for (int k = end_begin[c]; k < end_begin[c + 1]; ++k) ++row_first[end_row[k]];
   }
 }
 
@@ -257,16 +283,22 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
     const float norm = t_->norm[half_w + half_h];
     const std::int64_t threshold =
         t_->bound.SmallestHopeful([&](double v) { return Hopeless(v, norm, -1.f); });
+    // Three passes over the column, each window in grid order as Score() would take it; a pass
+    // only keeps the windows the next one needs. Why it is faster: the windows that pass the
+    // bound are scattered over the column, so their integral-image loads miss the cache. Between
+    // walks (long dependent chains that fill the out-of-order window) each such miss was waited
+    // for on its own; in a pass of sums alone the iterations are independent and the misses of
+    // several windows overlap. Why it is exact: every window still gets the same operations on
+    // the same values, the walks run in the same order, and hits are appended in the same order.
+    reached_.clear();
     const auto scan = [&](int begin, int end) {
       end = std::min(end, unclamped_end);
       for (y = grid_row_from(begin); y < end; y += stride_y) {
         ++visited;
         const int inner_r0 = y + inner_offset;
-        if (!t_->bound.Reaches(columns, y, y + box_height, inner_r0, inner_r0 + half_h,
-                               threshold)) {
-          continue;
+        if (t_->bound.Reaches(columns, y, y + box_height, inner_r0, inner_r0 + half_h, threshold)) {
+          reached_.push_back(y);
         }
-        score_rest(y, y + box_height, inner_r0, inner_r0 + half_h, norm);
       }
     };
     if (threshold == ContainmentBound::kNever) {
@@ -276,6 +308,32 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
       scan(0, unclamped_end);
     } else {
       for (const auto& [begin, end] : *tops) scan(begin, end);
+    }
+    // Pass 2: v of ScoreAfterBound (RectSum's terms in its order) and its early exit.
+    const size_t stride = static_cast<size_t>(height_) + 1;
+    const double* const anchor_left = t_->anchor_mag_integral.data() + c0 * stride;
+    const double* const anchor_right = t_->anchor_mag_integral.data() + (c1 + 1) * stride;
+    const double* const edge_left = t_->edge_mag_integral.data() + inner_c0 * stride;
+    const double* const edge_right = t_->edge_mag_integral.data() + (inner_c1 + 1) * stride;
+    hopeful_.clear();
+    for (size_t i = 0; i < reached_.size(); ++i) {
+      const int r0 = reached_[i], r1 = r0 + box_height;
+      const int inner_r0 = r0 + inner_offset, inner_r1 = inner_r0 + half_h;
+      const double v =
+          (anchor_right[r1 + 1] - anchor_right[r0] - anchor_left[r1 + 1] + anchor_left[r0]) -
+          (edge_right[inner_r1 + 1] - edge_right[inner_r0] - edge_left[inner_r1 + 1] +
+           edge_left[inner_r0]);
+      if (!Hopeless(v, norm, -1.f)) hopeful_.push_back(Hopeful{r0, v});
+    }
+    // Pass 3: the walks of the windows past the early exit.
+    for (size_t i = 0; i < hopeful_.size(); ++i) {
+      const int r0 = hopeful_[i].r0;
+      ++past_early_exit_;
+      const ScoreWindow w{r0, c0, r0 + box_height, c1, 0.f};
+      const float score = ScoreAfterEarlyExit(w, hopeful_[i].v, norm, -1.f);
+      if (score <= 0.f) continue;
+      nonzero.push_back(ScoreWindow{w.r0, w.c0, w.r1, w.c1, score});
+      if (rows != nullptr) rows->push_back(r0 / stride_y);
     }
   }
   for (y = grid_row_from(unclamped_end); y < y_end; y += stride_y) {  // the clamped windows
@@ -315,7 +373,6 @@ float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm,
     for (Node& node : nodes_) node.stamp = 0;
     stamp_ = 1;
   }
-  walk_size_ = 0;
   queue_head_ = 0;
   queue_size_ = 0;
   removed_ = 0.0;
@@ -325,42 +382,38 @@ float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm,
       if (nodes_[g].stamp != stamp_) AddWalkEntry(g, 1.f, AnchoredInside(nodes_[g], w));
     }
   };
-  const size_t top = static_cast<size_t>(w.r0) * width_;
-  const size_t bottom = static_cast<size_t>(w.r1) * width_;
-  const size_t left = static_cast<size_t>(w.c0) * height_;
-  const size_t right = static_cast<size_t>(w.c1) * height_;
+  const FirstRuns* const left = &t_->first_run[static_cast<size_t>(w.c0) * height_];
+  const FirstRuns* const right = &t_->first_run[static_cast<size_t>(w.c1) * height_];
   // Check after every side: half of the walks end here, often before all four are read.
-  add_boundary_runs(&t_->row_runs[t_->row_first_run[top + w.c0]], w.c1);
+  add_boundary_runs(&t_->row_runs[left[w.r0].row], w.c1);  // top
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(&t_->row_runs[t_->row_first_run[bottom + w.c0]], w.c1);
+  add_boundary_runs(&t_->row_runs[left[w.r1].row], w.c1);  // bottom
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(&t_->col_runs[t_->col_first_run[left + w.r0]], w.r1);
+  add_boundary_runs(&t_->col_runs[left[w.r0].col], w.r1);  // left
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(&t_->col_runs[t_->col_first_run[right + w.r0]], w.r1);
+  add_boundary_runs(&t_->col_runs[right[w.r0].col], w.r1);  // right
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
 
   while (queue_size_ > 0) {
-    const int slot = queue_[queue_head_];
+    const int s = queue_[queue_head_];
     queue_head_ = queue_head_ + 1 == ring_size_ ? 0 : queue_head_ + 1;
     --queue_size_;
-    walk_[slot].queued = false;
-    const float weight = walk_[slot].weight;
-    const int s = walk_[slot].group;
-    const Affinity* edge = t_->walk_edges.data() + t_->walk_edge_begin[s];
-    const Affinity* const end = t_->walk_edges.data() + t_->walk_edge_begin[s + 1];
+    nodes_[s].queued = false;
+    const float weight = nodes_[s].weight;
+    const Affinity* edge = t_->walk_edges.data() + nodes_[s].edge_begin;
+    const Affinity* const end = t_->walk_edges.data() + nodes_[s].edge_end;
     for (; edge != end; ++edge) {
       const float wt = weight * edge->value;
       if (wt < kMinPathWeight) continue;
-      const Node& node = nodes_[edge->target];
+      Node& node = nodes_[edge->target];
       if (node.stamp == stamp_) {
-        WalkEntry& entry = walk_[node.slot];
-        if (wt <= entry.weight) continue;
+        if (wt <= node.weight) continue;
         // Only inside groups can improve: boundary groups already hold weight 1.
-        removed_ += static_cast<double>(wt - entry.weight) * node.magnitude;
-        entry.weight = wt;
-        if (!entry.queued) {
-          entry.queued = true;
-          Enqueue(node.slot);
+        removed_ += static_cast<double>(wt - node.weight) * node.magnitude;
+        node.weight = wt;
+        if (!node.queued) {
+          node.queued = true;
+          Enqueue(edge->target);
         }
       } else if (AnchoredInside(node, w)) {
         AddWalkEntry(edge->target, wt, true);

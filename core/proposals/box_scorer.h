@@ -54,12 +54,19 @@ class BoxScorer {
   // The real constructor, for a map already free of NaN / inf.
   BoxScorer(const cv::Mat1f& finite_edge_map, const EdgeBoxParams& params, int finite_tag);
 
-  // Per-group data the walk touches, packed into one cache line fetch.
-  struct Node {
-    std::uint32_t stamp = 0;  // == stamp_ when the group is in the current walk
-    int slot = 0;             // its entry in walk_
+  // Everything the walk reads or writes about one group in one aligned 32-byte record, so a
+  // visit costs one cache line: whether the group is in the current walk and its weight (the
+  // walk state), the inside test, the subtracted magnitude and its walk edges. A separate walk
+  // list indexed from here, and the edge offsets in their own table, were two more dependent
+  // loads per visited group. Exact: the walk keeps the same values (a weight per walked group),
+  // visits the groups in the same queue order and does the same float / double operations.
+  struct alignas(32) Node {
+    std::uint32_t stamp = 0;  // == stamp_ when the group is in the current walk; then:
+    float weight = 0.f;       //   its largest path product so far
+    bool queued = false;      //   whether it waits in queue_ to propagate a changed weight
     int anchor_x = 0, anchor_y = 0;
     float magnitude = 0.f;
+    int edge_begin = 0, edge_end = 0;  // its walk edges: walk_edges[edge_begin, edge_end)
   };
   struct Affinity {
     int target = 0;
@@ -71,11 +78,11 @@ class BoxScorer {
     int start = 0;
     int group = 0;
   };
-  struct WalkEntry {
-    int group = 0;
-    float weight = 0.f;
-    bool inside = false;  // anchored inside the box: its weighted magnitude is subtracted
-    bool queued = false;
+  // Index into row_runs (col_runs) of the first run of row r (column c) that ends at or after
+  // column c (row r).
+  struct FirstRuns {
+    int row = 0;
+    int col = 0;
   };
 
   // Everything derived from the map once; read-only while scoring.
@@ -87,13 +94,17 @@ class BoxScorer {
     std::vector<float> norm;                  // (bw + bh)^(-kappa), index bw + bh
     ContainmentBound bound;                   // skips most walks before they start
     // Runs of one group (id > 0) along each row (column), in order: the groups touching the box
-    // side [c0, c1] of row r are those of the runs from row_first_run[r * width + c0] (the first
-    // run of row r that ends at or after c0) while their start is <= c1.
+    // side [c0, c1] of row r are those of the runs from first_run[c0 * height + r].row (the first
+    // run of row r that ends at or after c0) while their start is <= c1; those of the side
+    // [r0, r1] of column c are the runs from first_run[c * height + r0].col on.
     std::vector<Run> row_runs, col_runs;
-    std::vector<int> row_first_run;  // at r * width + c
-    std::vector<int> col_first_run;  // at c * height + r
+    // Both indexes in one column-major table: the grid visits the windows of a column with the
+    // top row increasing, so the lookups of consecutive walks (top and left side at (r0, c0),
+    // bottom at (r1, c0), right at (r0, c1)) move forward through three streams instead of
+    // landing on a new 4 KiB page each (as a row-major row index would), and the top and left
+    // lookups share one cache line.
+    std::vector<FirstRuns> first_run;  // at c * height + r
     // Affinity graph without the edges that can never carry a weight >= 0.05.
-    std::vector<int> walk_edge_begin;
     std::vector<Affinity> walk_edges;
   };
 
@@ -123,21 +134,19 @@ class BoxScorer {
     const float score = static_cast<float>(v_left) * norm;
     return score < params_.min_score || score <= bar;
   }
-  void Enqueue(int slot) {
+  void Enqueue(int group) {
     int tail = queue_head_ + queue_size_;
     if (tail >= ring_size_) tail -= ring_size_;
-    queue_[tail] = slot;
+    queue_[tail] = group;
     ++queue_size_;
   }
   void AddWalkEntry(int group, float weight, bool inside) {
     Node& node = nodes_[group];
     node.stamp = stamp_;
-    node.slot = walk_size_;
+    node.weight = weight;
     // A group without walk edges propagates nothing: it needs no turn in the queue.
-    const bool propagates = t_->walk_edge_begin[group] != t_->walk_edge_begin[group + 1];
-    walk_[walk_size_] = WalkEntry{group, weight, inside, propagates};
-    if (propagates) Enqueue(walk_size_);
-    ++walk_size_;
+    node.queued = node.edge_begin != node.edge_end;
+    if (node.queued) Enqueue(group);
     if (inside) removed_ += static_cast<double>(weight) * node.magnitude;
   }
 
@@ -151,13 +160,19 @@ class BoxScorer {
   const Tables* t_ = nullptr;  // tables_.get(), for short access in the hot paths
   // Scratch of the walk, sized by the group count and reused through stamp_.
   std::vector<Node> nodes_;
-  std::vector<WalkEntry> walk_;
-  std::vector<int> queue_;  // ring of walk_ slots whose weight must be propagated
-  int walk_size_ = 0;
+  std::vector<int> queue_;  // ring of the groups whose weight must be propagated
   int queue_head_ = 0, queue_size_ = 0, ring_size_ = 0;
   std::uint32_t stamp_ = 0;
   double removed_ = 0.0;  // running sum of weight * magnitude over walked groups inside the box
   long long past_early_exit_ = 0;
+  // Scratch of ScoreColumn: the grid rows of one column that pass the containment bound, and
+  // those of them that pass the early exit, with their v.
+  struct Hopeful {
+    int r0 = 0;
+    double v = 0.0;
+  };
+  std::vector<int> reached_;
+  std::vector<Hopeful> hopeful_;
 };
 
 }  // namespace tod
