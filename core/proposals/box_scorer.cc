@@ -253,7 +253,7 @@ void BoxScorer::ScoreImpl(ScoreWindow& w, float bar, bool use_bound) {
 }
 
 int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
-                           const RowRanges* tops, std::vector<ScoreWindow>& nonzero,
+                           const RowRanges* tops, float bar, std::vector<ScoreWindow>& nonzero,
                            std::vector<int>* rows) {
   int visited = 0;
   // Score() on each window of the column, with the per-column work hoisted: the clamped
@@ -265,7 +265,7 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
   int y = 0;
   const auto score_rest = [&](int r0, int r1, int inner_r0, int inner_r1, float norm) {
     const ScoreWindow w{r0, c0, r1, c1, 0.f};
-    const float score = ScoreAfterBound(w, inner_r0, inner_c0, inner_r1, inner_c1, norm, -1.f);
+    const float score = ScoreAfterBound(w, inner_r0, inner_c0, inner_r1, inner_c1, norm, bar);
     if (score <= 0.f) return;
     nonzero.push_back(ScoreWindow{r0, c0, r1, c1, score});
     if (rows != nullptr) rows->push_back(y / stride_y);
@@ -282,7 +282,7 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
     const int half_h = box_height / 2, inner_offset = half_h / 2;
     const float norm = t_->norm[half_w + half_h];
     const std::int64_t threshold =
-        t_->bound.SmallestHopeful([&](double v) { return Hopeless(v, norm, -1.f); });
+        t_->bound.SmallestHopeful([&](double v) { return Hopeless(v, norm, bar); });
     // Three passes over the column, each window in grid order as Score() would take it; a pass
     // only keeps the windows the next one needs. Why it is faster: the windows that pass the
     // bound are scattered over the column, so their integral-image loads miss the cache. Between
@@ -323,14 +323,14 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
           (anchor_right[r1 + 1] - anchor_right[r0] - anchor_left[r1 + 1] + anchor_left[r0]) -
           (edge_right[inner_r1 + 1] - edge_right[inner_r0] - edge_left[inner_r1 + 1] +
            edge_left[inner_r0]);
-      if (!Hopeless(v, norm, -1.f)) hopeful_.push_back(Hopeful{r0, v});
+      if (!Hopeless(v, norm, bar)) hopeful_.push_back(Hopeful{r0, v});
     }
     // Pass 3: the walks of the windows past the early exit.
     for (size_t i = 0; i < hopeful_.size(); ++i) {
       const int r0 = hopeful_[i].r0;
       ++past_early_exit_;
       const ScoreWindow w{r0, c0, r0 + box_height, c1, 0.f};
-      const float score = ScoreAfterEarlyExit(w, hopeful_[i].v, norm, -1.f);
+      const float score = ScoreAfterEarlyExit(w, hopeful_[i].v, norm, bar);
       if (score <= 0.f) continue;
       nonzero.push_back(ScoreWindow{w.r0, w.c0, w.r1, w.c1, score});
       if (rows != nullptr) rows->push_back(r0 / stride_y);
@@ -342,7 +342,7 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
     const int half_h = (r1 - r0) / 2;
     const int inner_r0 = r0 + half_h / 2, inner_r1 = inner_r0 + half_h;
     const float norm = t_->norm[half_w + half_h];
-    if (Hopeless(t_->bound.Bound(columns, r0, r1, inner_r0, inner_r1), norm, -1.f)) continue;
+    if (Hopeless(t_->bound.Bound(columns, r0, r1, inner_r0, inner_r1), norm, bar)) continue;
     score_rest(r0, r1, inner_r0, inner_r1, norm);
   }
   return visited;

@@ -35,12 +35,13 @@ class BoxScorer {
   void Score(ScoreWindow& window, float bar = -1.f);
   // Scores the sliding-window column at x of one window shape (nominal extent box_width x
   // box_height, row stride stride_y; rows y = 0, stride_y, ... while y < height - box_height +
-  // stride_y) exactly as Score() would, and appends the clamped windows with a non-zero score
-  // (and, with `rows`, their grid row index y / stride_y). With `tops`, only the unclamped
-  // windows whose top row lies in one of those ranges are scored (the clamped ones always are).
-  // Returns how many windows it visited.
+  // stride_y) exactly as Score(window, bar) would, and appends the clamped windows with a
+  // non-zero score (and, with `rows`, their grid row index y / stride_y): with bar < 0 every
+  // window scoring at least min_score, otherwise those scoring above bar. With `tops`, only the
+  // unclamped windows whose top row lies in one of those ranges are scored (the clamped ones
+  // always are). Returns how many windows it visited.
   int ScoreColumn(int x, int box_width, int box_height, int stride_y, const RowRanges* tops,
-                  std::vector<ScoreWindow>& nonzero, std::vector<int>* rows = nullptr);
+                  float bar, std::vector<ScoreWindow>& nonzero, std::vector<int>* rows = nullptr);
   // Coordinate search on the four sides with halving steps, accepting improvements.
   void Refine(ScoreWindow& window);
 

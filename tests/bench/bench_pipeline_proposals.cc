@@ -52,6 +52,7 @@ void Add(Totals& t, const tod::EdgeBoxStats& s, long long kept) {
   t.stats.windows_past_early_exit += s.windows_past_early_exit;
   t.stats.windows_refined += s.windows_refined;
   t.stats.scorings += s.scorings;
+  t.stats.rescans += s.rescans;
   t.kept += kept;
 }
 
@@ -137,16 +138,17 @@ int main(int argc, char** argv) {
   std::printf("frame %dx%d, %d frames, one core; counts per frame (mean), times median\n",
               synth.width, synth.height, frames);
   std::printf(
-      "| configuration | ms | vs paper | windows scored | walks | refined | kept boxes | digest |\n"
-      "|---|---|---|---|---|---|---|---|\n");
+      "| configuration | ms | vs paper | windows scored | walks | refined | kept boxes | rescanned "
+      "regions | digest |\n"
+      "|---|---|---|---|---|---|---|---|---|\n");
   const double paper_ms = Median(config_totals[0].ms);
   for (size_t c = 0; c < configs.size(); ++c) {
     const Totals& t = config_totals[c];
     const double ms = Median(t.ms);
-    std::printf("| %s | %.1f | %.2fx | %lld | %lld | %lld | %lld | %016llx |\n",
+    std::printf("| %s | %.1f | %.2fx | %lld | %lld | %lld | %lld | %lld of %d | %016llx |\n",
                 configs[c].name.c_str(), ms, ms > 0 ? paper_ms / ms : 0.0,
                 t.stats.windows_visited / frames, t.stats.scorings / frames,
-                t.stats.windows_refined / frames, t.kept / frames,
+                t.stats.windows_refined / frames, t.kept / frames, t.stats.rescans, frames * layers,
                 static_cast<unsigned long long>(t.digest));
   }
   std::printf("\nper region, %s\n", configs.back().name.c_str());
