@@ -1,6 +1,7 @@
 #include "core/edges/occlusion_classifier.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -28,12 +29,37 @@ Status ValidateMaps(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
   if (superpixels.labels.size() != image.size()) {
     return Status::InvalidArgument(what + ": superpixels.labels size differs from the image size");
   }
-  if (!cv::checkRange(enhanced_edge)) {
+  // One vectorisable pass per map instead of cv::checkRange and cv::minMaxLoc (same verdicts:
+  // a float is NaN or infinite exactly when its exponent bits are all ones).
+  bool finite = true;
+  for (int y = 0; y < enhanced_edge.rows; ++y) {
+    const float* row = enhanced_edge[y];
+    std::uint32_t all_ones = 0;  // non-zero once some value has an all-ones exponent
+    for (int x = 0; x < enhanced_edge.cols; ++x) {
+      const std::uint32_t bits = std::bit_cast<std::uint32_t>(row[x]);
+      all_ones |= static_cast<std::uint32_t>((bits & 0x7f800000u) == 0x7f800000u);
+    }
+    if (all_ones != 0) {
+      finite = false;
+      break;
+    }
+  }
+  if (!finite) {
     return Status::InvalidArgument(what + ": enhanced_edge contains NaN or infinity");
   }
-  double min_label = 0.0;
-  double max_label = 0.0;
-  cv::minMaxLoc(superpixels.labels, &min_label, &max_label);
+  int min_label = 0;
+  int max_label = 0;
+  for (int y = 0; y < superpixels.labels.rows; ++y) {
+    const int* row = superpixels.labels[y];
+    int row_min = row[0];
+    int row_max = row[0];
+    for (int x = 1; x < superpixels.labels.cols; ++x) {
+      row_min = std::min(row_min, row[x]);
+      row_max = std::max(row_max, row[x]);
+    }
+    min_label = y == 0 ? row_min : std::min(min_label, row_min);
+    max_label = y == 0 ? row_max : std::max(max_label, row_max);
+  }
   if (min_label < 0 || max_label > superpixels.count) {
     return Status::InvalidArgument(what + ": superpixels.labels outside [0, superpixels.count=" +
                                    std::to_string(superpixels.count) + "]");
@@ -220,8 +246,14 @@ Result<cv::Mat1f> OcclusionClassifier::PaintChecked(const cv::Mat3b& image,
   }
 
   const float floor = params_.floor;
-  cv::Mat1f painted(image.size(), 0.f);
-  painted.setTo(floor, superpixels.labels == 0);
+  // One pass: floor on label 0, 0 elsewhere (the former zero fill, `labels == 0` mask and
+  // masked setTo wrote the same values in three passes and a temporary mask).
+  cv::Mat1f painted(image.size());
+  for (int y = 0; y < painted.rows; ++y) {
+    const int* label = superpixels.labels[y];
+    float* row = painted[y];
+    for (int x = 0; x < painted.cols; ++x) row[x] = label[x] == 0 ? floor : 0.f;
+  }
   float* const out = painted.ptr<float>(0);
   for (size_t i = 0; i < pairs.boundary_pixels.size(); ++i) {
     float value = floor;

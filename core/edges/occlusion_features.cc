@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <opencv2/core/hal/hal.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -53,11 +55,22 @@ std::vector<RegionStats> ComputeRegionStats(const cv::Mat3b& image, const cv::Ma
   cv::cvtColor(image, hsv, cv::COLOR_BGR2HSV);  // 8-bit: H in [0,180), S and V in [0,256)
   cv::Mat1b gray;
   cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
-  cv::Mat1f gx;
-  cv::Mat1f gy;
-  cv::Sobel(gray, gx, CV_32F, 1, 0, 3);
-  cv::Sobel(gray, gy, CV_32F, 0, 1, 3);
+  // The 3x3 Sobel derivatives of an 8-bit image are integers in [-1020, 1020]: cv::Sobel into
+  // CV_32F and cv::spatialGradient into CV_16S compute the same integers (same kernels, same
+  // BORDER_DEFAULT border), and int16 -> float is exact. spatialGradient does both derivatives
+  // in one pass over the image instead of two separable filters each.
+  cv::Mat gx16;
+  cv::Mat gy16;
+  cv::spatialGradient(gray, gx16, gy16, 3, cv::BORDER_DEFAULT);
 
+  // Integer sums per region while scanning (see the loop below); RegionStats at the end.
+  struct Sums {
+    std::int64_t area = 0;
+    std::int64_t sum_y = 0;
+    std::array<std::int64_t, 3> sum_luv{};
+    std::array<std::int32_t, 3 * kColourBins> hsv_count{};
+  };
+  std::vector<Sums> sums(static_cast<size_t>(count) + 1);
   std::vector<RegionStats> stats(static_cast<size_t>(count) + 1);
   // Directions of the inner texture-bin edges kπ/8, k = 1..7.
   std::array<float, kTextureBins - 1> edge_cos{};
@@ -66,26 +79,64 @@ std::vector<RegionStats> ComputeRegionStats(const cv::Mat3b& image, const cv::Ma
     edge_cos[k] = static_cast<float>(std::cos((k + 1) * CV_PI / kTextureBins));
     edge_sin[k] = static_cast<float>(std::sin((k + 1) * CV_PI / kTextureBins));
   }
-  std::vector<float> magnitude(static_cast<size_t>(labels.cols));
-  std::vector<int> texture_bin(static_cast<size_t>(labels.cols));
+  const int cols = labels.cols;
+  std::vector<float> gx(static_cast<size_t>(cols));
+  std::vector<float> gy(static_cast<size_t>(cols));
+  std::vector<float> magnitude(static_cast<size_t>(cols));
+  std::vector<int> texture_bin(static_cast<size_t>(cols));
   for (int y = 0; y < labels.rows; ++y) {
     const int* l = labels[y];
-    const cv::Vec3b* luv_row = luv[y];
-    const cv::Vec3b* hsv_row = hsv[y];
-    TextureRow(gx[y], gy[y], labels.cols, edge_cos, edge_sin, magnitude.data(), texture_bin.data());
-    for (int x = 0; x < labels.cols; ++x) {
-      if (l[x] <= 0) continue;
-      RegionStats& s = stats[l[x]];
-      s.area += 1.0;
-      s.sum_y += y;
-      for (int c = 0; c < 3; ++c) s.sum_luv[c] += luv_row[x][c];
-      s.hsv_hist[hsv_row[x][0] * kColourBins / 180] += 1.f;
-      s.hsv_hist[kColourBins + hsv_row[x][1] * kColourBins / 256] += 1.f;
-      s.hsv_hist[2 * kColourBins + hsv_row[x][2] * kColourBins / 256] += 1.f;
-      if (magnitude[x] > 0.f) s.texture_hist[texture_bin[x]] += magnitude[x];
+    const cv::Vec3b* luv_row = luv.ptr<cv::Vec3b>(y);
+    const cv::Vec3b* hsv_row = hsv.ptr<cv::Vec3b>(y);
+    const std::int16_t* gx_row = gx16.ptr<std::int16_t>(y);
+    const std::int16_t* gy_row = gy16.ptr<std::int16_t>(y);
+    for (int x = 0; x < cols; ++x) {
+      gx[x] = gx_row[x];
+      gy[x] = gy_row[x];
+    }
+    TextureRow(gx.data(), gy.data(), cols, edge_cos, edge_sin, magnitude.data(),
+               texture_bin.data());
+    // One run of equal labels at a time: the region is looked up once per run and its area,
+    // row and LUV sums are kept in registers (the former per-pixel double additions to memory
+    // formed one long store-to-load chain). These sums are integers, exact in any order; the
+    // texture sums are float and stay one addition per pixel in pixel order.
+    for (int x = 0; x < cols;) {
+      const int label = l[x];
+      if (label <= 0) {
+        ++x;
+        continue;
+      }
+      int end = x + 1;
+      while (end < cols && l[end] == label) ++end;
+      Sums& s = sums[label];
+      RegionStats& r = stats[label];
+      std::array<std::int64_t, 3> luv_sum = s.sum_luv;
+      for (int i = x; i < end; ++i) {
+        for (int c = 0; c < 3; ++c) luv_sum[c] += luv_row[i][c];
+        ++s.hsv_count[hsv_row[i][0] * kColourBins / 180];
+        ++s.hsv_count[kColourBins + hsv_row[i][1] * kColourBins / 256];
+        ++s.hsv_count[2 * kColourBins + hsv_row[i][2] * kColourBins / 256];
+        if (magnitude[i] > 0.f) r.texture_hist[texture_bin[i]] += magnitude[i];
+      }
+      s.sum_luv = luv_sum;
+      s.area += end - x;
+      s.sum_y += static_cast<std::int64_t>(y) * (end - x);
+      x = end;
     }
   }
-  for (RegionStats& s : stats) {
+  // The former code summed 1.0, y and the LUV bytes into doubles (exact: integers far below
+  // 2^53) and counted the histograms with float += 1.f, which is exact up to 2^24 and then stays
+  // at 2^24 (2^24 + 1 rounds to even); min(count, 2^24) reproduces that.
+  constexpr std::int32_t kFloatCountLimit = std::int32_t{1} << std::numeric_limits<float>::digits;
+  for (size_t i = 0; i < stats.size(); ++i) {
+    RegionStats& s = stats[i];
+    const Sums& t = sums[i];
+    s.area = static_cast<double>(t.area);
+    s.sum_y = static_cast<double>(t.sum_y);
+    for (int c = 0; c < 3; ++c) s.sum_luv[c] = static_cast<double>(t.sum_luv[c]);
+    for (int b = 0; b < 3 * kColourBins; ++b) {
+      s.hsv_hist[b] = static_cast<float>(std::min(t.hsv_count[b], kFloatCountLimit));
+    }
     if (s.area > 0) {
       for (float& v : s.hsv_hist) v /= static_cast<float>(s.area);
     }
@@ -132,37 +183,70 @@ SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& 
 
   // Boundary pixels and the pairs each borders.
   std::vector<std::vector<cv::Vec2i>> adjacency(static_cast<size_t>(superpixels.count) + 1);
+  // Consecutive boundary pixels nearly always border the same pair: a one-entry cache in front
+  // of PairIndex skips the adjacency scan. PairIndex returns the same index for a pair every
+  // time after its first call, so the cache changes nothing.
+  int cached_a = -1, cached_b = -1, cached_index = -1;
+  auto pair_index = [&](int a, int b) {
+    if (a != cached_a || b != cached_b) {
+      cached_a = a;
+      cached_b = b;
+      cached_index = PairIndex(a, b, adjacency, out.pairs);
+    }
+    return cached_index;
+  };
+  // Coordinates of every boundary pixel, so that the per-pair loops below need no division of
+  // the flat index.
+  std::vector<cv::Point> boundary_points;
   for (int y = 0; y < height; ++y) {
     const int* row = labels[y];
+    const int* above = y > 0 ? labels[y - 1] : nullptr;
+    const int* below = y + 1 < height ? labels[y + 1] : nullptr;
     for (int x = 0; x < width; ++x) {
       if (row[x] != 0) continue;
       std::array<int, 9> seen{};  // 8 neighbours + the centre slot
       int num_seen = 0;
-      for (int dy = -1; dy <= 1; ++dy) {
-        const int yy = y + dy;
-        if (yy < 0 || yy >= height) continue;
-        const int* nrow = labels[yy];
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int xx = x + dx;
-          if (xx < 0 || xx >= width) continue;
-          const int t = nrow[xx];
-          if (t <= 0) continue;
-          // Insert t keeping `seen` sorted and distinct (at most 8 entries).
-          int pos = 0;
-          while (pos < num_seen && seen[pos] < t) ++pos;
-          if (pos < num_seen && seen[pos] == t) continue;
-          for (int m = num_seen; m > pos; --m) seen[m] = seen[m - 1];
-          seen[pos] = t;
-          ++num_seen;
+      // Insert t keeping `seen` sorted and distinct (at most 8 entries); the set does not depend
+      // on the order of the neighbours.
+      auto insert = [&seen, &num_seen](int t) {
+        if (t <= 0) return;
+        int pos = 0;
+        while (pos < num_seen && seen[pos] < t) ++pos;
+        if (pos < num_seen && seen[pos] == t) return;
+        for (int m = num_seen; m > pos; --m) seen[m] = seen[m - 1];
+        seen[pos] = t;
+        ++num_seen;
+      };
+      if (above != nullptr && below != nullptr && x > 0 && x + 1 < width) {
+        // Interior pixel: the eight neighbours without bounds checks (the centre is 0).
+        insert(above[x - 1]);
+        insert(above[x]);
+        insert(above[x + 1]);
+        insert(row[x - 1]);
+        insert(row[x + 1]);
+        insert(below[x - 1]);
+        insert(below[x]);
+        insert(below[x + 1]);
+      } else {
+        for (int dy = -1; dy <= 1; ++dy) {
+          const int yy = y + dy;
+          if (yy < 0 || yy >= height) continue;
+          const int* nrow = labels[yy];
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx;
+            if (xx < 0 || xx >= width) continue;
+            insert(nrow[xx]);
+          }
         }
       }
       if (num_seen < 2) continue;
       for (int i = 0; i < num_seen; ++i) {
         for (int j = i + 1; j < num_seen; ++j) {
-          out.pixel_pairs.push_back(PairIndex(seen[i], seen[j], adjacency, out.pairs));
+          out.pixel_pairs.push_back(pair_index(seen[i], seen[j]));
         }
       }
       out.boundary_pixels.push_back(y * width + x);
+      boundary_points.emplace_back(x, y);
       out.pixel_offsets.push_back(static_cast<int>(out.pixel_pairs.size()));
     }
   }
@@ -172,12 +256,12 @@ SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& 
   std::vector<int> pair_offsets(static_cast<size_t>(num_pairs) + 1, 0);
   for (int p : out.pixel_pairs) ++pair_offsets[p + 1];
   for (int p = 0; p < num_pairs; ++p) pair_offsets[p + 1] += pair_offsets[p];
-  std::vector<int> pair_pixels(out.pixel_pairs.size());
+  std::vector<cv::Point> pair_pixels(out.pixel_pairs.size());
   {
     std::vector<int> cursor(pair_offsets.begin(), pair_offsets.end() - 1);
-    for (size_t i = 0; i < out.boundary_pixels.size(); ++i) {
+    for (size_t i = 0; i < boundary_points.size(); ++i) {
       for (int k = out.pixel_offsets[i]; k < out.pixel_offsets[i + 1]; ++k) {
-        pair_pixels[cursor[out.pixel_pairs[k]]++] = out.boundary_pixels[i];
+        pair_pixels[cursor[out.pixel_pairs[k]]++] = boundary_points[i];
       }
     }
   }
@@ -195,10 +279,10 @@ SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& 
     double sum_x = 0.0;
     double sum_y = 0.0;
     for (int k = begin; k < end; ++k) {
-      const int pixel = pair_pixels[k];
-      values.push_back(enhanced_edge(pixel / width, pixel % width));
-      sum_x += pixel % width;
-      sum_y += pixel / width;
+      const cv::Point pixel = pair_pixels[k];
+      values.push_back(enhanced_edge(pixel.y, pixel.x));
+      sum_x += pixel.x;
+      sum_y += pixel.y;
     }
     const double mean_x = sum_x / length;
     const double mean_y = sum_y / length;
@@ -206,8 +290,8 @@ SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& 
     double syy = 0.0;
     double sxy = 0.0;
     for (int k = begin; k < end; ++k) {
-      const double dx = pair_pixels[k] % width - mean_x;
-      const double dy = pair_pixels[k] / width - mean_y;
+      const double dx = pair_pixels[k].x - mean_x;
+      const double dy = pair_pixels[k].y - mean_y;
       sxx += dx * dx;
       syy += dy * dy;
       sxy += dx * dy;

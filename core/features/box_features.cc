@@ -216,6 +216,14 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
 
 cv::Mat1f BoxFeatureExtractor::ComputeAll(const std::vector<ScoredBox>& proposals) const {
   cv::Mat1f features(static_cast<int>(proposals.size()), kNumBoxFeatures);
+  std::vector<int> rows(proposals.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) rows[i] = static_cast<int>(i);
+  ComputeInto(proposals, rows, features);
+  return features;
+}
+
+void BoxFeatureExtractor::ComputeInto(const std::vector<ScoredBox>& proposals,
+                                      const std::vector<int>& out_rows, cv::Mat1f& out) const {
   // Visit the boxes in a spatial order (proposals arrive by objectness, i.e. scattered over the
   // region): consecutive boxes then read the same rows of the edge runs and colour tables, which
   // stay in cache. Compute() depends on its box only and each result goes to its own row, so
@@ -228,9 +236,8 @@ cv::Mat1f BoxFeatureExtractor::ComputeAll(const std::vector<ScoredBox>& proposal
   std::sort(order.begin(), order.end());
   for (const auto& [key, i] : order) {
     const BoxFeatureVector f = Compute(proposals[i].box, proposals[i].score);
-    std::copy(f.begin(), f.end(), features[i]);
+    std::copy(f.begin(), f.end(), out[out_rows[i]]);
   }
-  return features;
 }
 
 }  // namespace tod

@@ -88,6 +88,11 @@ class BoxFeatureExtractor {
 
   // One row of 20 features per proposal (box + OLP score), in input order; thread-safe.
   cv::Mat1f ComputeAll(const std::vector<ScoredBox>& proposals) const;
+  // As ComputeAll, but the features of proposals[j] go to row out_rows[j] of `out` (20 columns,
+  // every out_rows[j] a row of it): a caller that merges several regions' proposals into one
+  // matrix writes each row once instead of copying it over.
+  void ComputeInto(const std::vector<ScoredBox>& proposals, const std::vector<int>& out_rows,
+                   cv::Mat1f& out) const;
 
  private:
   // Validates, then builds the sparse edge map; leaves the extractor empty on error.

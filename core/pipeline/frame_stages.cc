@@ -127,9 +127,9 @@ cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& 
     const Box region = Intersect(regions.layers[k], oaocc.r1);
     const BoxFeatureExtractor extractor(frame_colour, RegionEdgeMap(oaocc, regions, k),
                                         cv::Point(region.x, region.y), image.size());
-    const cv::Mat1f region_rows = extractor.ComputeAll(boxes);
-    for (std::size_t j = 0; j < members.size(); ++j)
-      region_rows.row(static_cast<int>(j)).copyTo(rows.row(members[j]));
+    // Each region's features go straight to their rows of the merged matrix (no per-row
+    // cv::Mat copy).
+    extractor.ComputeInto(boxes, members, rows);
   }
   return rows;
 }

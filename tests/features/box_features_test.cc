@@ -285,6 +285,32 @@ TEST(BoxFeaturesTest, ComputeAllOfScatteredBoxesKeepsInputOrder) {
   }
 }
 
+TEST(BoxFeaturesTest, ComputeIntoWritesTheGivenRows) {
+  cv::RNG rng(5);
+  cv::Mat1f map(50, 90, 0.f);
+  for (int i = 0; i < 200; ++i) map(rng.uniform(0, 50), rng.uniform(0, 90)) = 0.125f * (i % 5 + 1);
+  cv::Mat3b bgr(50, 90);
+  rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
+  const BoxFeatureExtractor extractor(map, bgr, {4, 2}, {120, 60});
+  std::vector<ScoredBox> proposals;
+  std::vector<int> rows;
+  for (int i = 0; i < 40; ++i) {
+    proposals.push_back(
+        {{rng.uniform(0, 90), rng.uniform(0, 50), rng.uniform(1, 60), rng.uniform(1, 40)},
+         0.01f * i});
+    rows.push_back(2 * (39 - i) + 1);  // reversed, odd rows only
+  }
+  cv::Mat1f out(81, kNumBoxFeatures, -1.f);
+  extractor.ComputeInto(proposals, rows, out);
+  const cv::Mat1f all = extractor.ComputeAll(proposals);
+  for (int i = 0; i < 40; ++i) {
+    for (int c = 0; c < kNumBoxFeatures; ++c) ASSERT_EQ(out(rows[i], c), all(i, c)) << i;
+  }
+  for (int r = 0; r < 81; r += 2) {
+    for (int c = 0; c < kNumBoxFeatures; ++c) ASSERT_EQ(out(r, c), -1.f) << "row " << r;
+  }
+}
+
 TEST(BoxFeaturesTest, InvalidInputIsAnError) {
   const cv::Mat3b colour = Uniform(8, 8, {0, 0, 0});
   auto mismatch = BoxFeatureExtractor::Create(cv::Mat1f(8, 7, 0.f), colour, {0, 0}, {8, 8});
