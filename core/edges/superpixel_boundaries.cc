@@ -8,36 +8,81 @@ namespace tod {
 int RelabelConnectedComponents(cv::Mat1i& labels) {
   const int width = labels.cols;
   const int height = labels.rows;
-  const size_t n = static_cast<size_t>(width) * height;
-  if (n == 0) return 0;
+  if (static_cast<size_t>(width) * height == 0) return 0;
   if (!labels.isContinuous()) labels = labels.clone();
   int* const l = labels.ptr<int>(0);
-  std::vector<int> out(n, 0);
-  std::vector<int> stack;
-  int count = 0;
-  for (size_t seed = 0; seed < n; ++seed) {
-    if (out[seed] != 0) continue;
-    const int id = l[seed];
-    out[seed] = ++count;
-    stack.push_back(static_cast<int>(seed));
-    while (!stack.empty()) {
-      const int i = stack.back();
-      stack.pop_back();
-      const int x = i % width;
-      const int y = i / width;
-      auto visit = [&](int j) {
-        if (out[j] == 0 && l[j] == id) {
-          out[j] = count;
-          stack.push_back(j);
-        }
-      };
-      if (x > 0) visit(i - 1);
-      if (x + 1 < width) visit(i + 1);
-      if (y > 0) visit(i - width);
-      if (y + 1 < height) visit(i + width);
+
+  // Two passes over runs (maximal horizontal stretches of one label) instead of a per-pixel
+  // flood fill: a superpixel row is a few long runs, so the work is per run, with no stack, no
+  // division to recover coordinates and no unpredictable branch per pixel.
+  //  1. Runs, row by row in raster order; a run 4-touches a run of the row above exactly when
+  //     their column ranges overlap, so a merge walk over the two rows unites every such pair
+  //     with the same label (union-find; the root of a set is its earliest run).
+  //  2. Ids in raster order of the runs: a component's first run holds its first pixel in raster
+  //     order, so components are numbered in order of first appearance, which is exactly how the
+  //     flood fill, seeding in raster order, numbered them.
+  struct Run {
+    int start;  // first column
+    int end;    // one past the last column
+    int label;
+  };
+  std::vector<Run> runs;
+  std::vector<size_t> row_first(static_cast<size_t>(height) + 1);
+  for (int y = 0; y < height; ++y) {
+    row_first[y] = runs.size();
+    const int* const row = l + static_cast<size_t>(y) * width;
+    for (int x = 0; x < width;) {
+      const int start = x;
+      const int label = row[x];
+      while (++x < width && row[x] == label) {
+      }
+      runs.push_back({start, x, label});
     }
   }
-  std::copy(out.begin(), out.end(), l);
+  row_first[height] = runs.size();
+
+  std::vector<size_t> parent(runs.size());
+  for (size_t r = 0; r < parent.size(); ++r) parent[r] = r;
+  const auto find = [&parent](size_t r) {
+    while (parent[r] != r) {
+      parent[r] = parent[parent[r]];  // path halving
+      r = parent[r];
+    }
+    return r;
+  };
+  for (int y = 1; y < height; ++y) {
+    size_t up = row_first[y - 1];
+    size_t down = row_first[y];
+    const size_t up_end = row_first[y];
+    const size_t down_end = row_first[y + 1];
+    // Invariant: runs `up` and `down` overlap (both rows start at column 0; the run that ends
+    // first is replaced by its successor, which starts where it ended, inside the other run).
+    while (up < up_end && down < down_end) {
+      if (runs[up].label == runs[down].label) {
+        const size_t a = find(up);
+        const size_t b = find(down);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+      const int up_stop = runs[up].end;
+      const int down_stop = runs[down].end;
+      if (up_stop <= down_stop) ++up;
+      if (down_stop <= up_stop) ++down;
+    }
+  }
+
+  std::vector<int> id(runs.size(), 0);
+  int count = 0;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    int& component = id[find(r)];
+    if (component == 0) component = ++count;
+    id[r] = component;
+  }
+  for (int y = 0; y < height; ++y) {
+    int* const row = l + static_cast<size_t>(y) * width;
+    for (size_t r = row_first[y]; r < row_first[y + 1]; ++r) {
+      std::fill(row + runs[r].start, row + runs[r].end, id[r]);
+    }
+  }
   return count;
 }
 
