@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdint>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -63,27 +62,6 @@ void RenumberDensely(std::vector<int>& labels, std::vector<LabelSums>& sums,
   original_id = std::move(dense_original);
 }
 
-// border[x] = whether pixel (x, y) has a 4-neighbour with another label. Most pixels are
-// interior: this branch-free pass (which vectorises) spares the sweep their scalar checks.
-void MarkRowBorder(const int* labels, int width, int height, int y, std::uint8_t* border) {
-  const int* row = labels + static_cast<size_t>(y) * width;
-  // A missing row above or below compares the row with itself: never a difference.
-  const int* up = y > 0 ? row - width : row;
-  const int* down = y + 1 < height ? row + width : row;
-  const auto vertical = [&](int x) { return (up[x] != row[x]) | (down[x] != row[x]); };
-  if (width == 1) {
-    border[0] = static_cast<std::uint8_t>(vertical(0));
-    return;
-  }
-  border[0] = static_cast<std::uint8_t>(vertical(0) | (row[1] != row[0]));
-  for (int x = 1; x + 1 < width; ++x) {
-    border[x] =
-        static_cast<std::uint8_t>(vertical(x) | (row[x - 1] != row[x]) | (row[x + 1] != row[x]));
-  }
-  border[width - 1] =
-      static_cast<std::uint8_t>(vertical(width - 1) | (row[width - 2] != row[width - 1]));
-}
-
 }  // namespace
 
 StickyWeights StickyWeightsFor(int k, double alpha, double beta) {
@@ -114,19 +92,11 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
   }
 
   int sweeps = 0;
-  std::vector<std::uint8_t> row_border(static_cast<size_t>(width));
   for (int iter = 0; iter < iterations; ++iter) {
     ++sweeps;
     long long moved = 0;
     for (int y = 0; y < height; ++y) {
-      MarkRowBorder(labels.data(), width, height, y, row_border.data());
-      bool left_moved = false;
       for (int x = 0; x < width; ++x) {
-        // The row's flags hold for the labels as they were before the row was swept; of a
-        // pixel's neighbours only the left one can have changed since (by its own move), so a
-        // pixel whose left neighbour moved is checked afresh below.
-        if (row_border[x] == 0 && !left_moved) continue;
-        left_moved = false;
         const size_t i = static_cast<size_t>(y) * width + x;
         const int own = labels[i];
         // Interior pixels (every 4-neighbour shares the label) cannot move: decided from the
@@ -197,7 +167,6 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
           sums[best].Add(1.0, x, y, c);
           labels[i] = best;
           ++moved;
-          left_moved = true;
         }
       }
     }
