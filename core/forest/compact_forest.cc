@@ -10,11 +10,13 @@ namespace tod {
 namespace {
 
 // Rows descending one tree in lock-step. Enough independent chains to cover the latency of a
-// node load from L2, few enough that the lane state stays in registers.
-constexpr int kLanes = 8;
-// Steps between tests for "all lanes reached a leaf" (2, 4 and 8 measured within a few percent;
-// 4 was best).
-constexpr int kStepsPerCheck = 4;
+// node load, few enough that the lane state stays in registers: with the rows copied to a fixed
+// stride a lane needs one register, and 12 lanes beat 8 (regression stage 209-215 -> 194-200 ms
+// a frame, bench_pipeline_frame side by side); 14 and 16 were no better.
+constexpr int kLanes = 12;
+// Steps between tests for "all lanes reached a leaf" (3 measured slightly better than 4 with 12
+// lanes, 8 worse).
+constexpr int kStepsPerCheck = 3;
 
 }  // namespace
 

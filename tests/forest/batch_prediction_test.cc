@@ -166,7 +166,7 @@ RandomForest DeepForest() {
 TEST(BatchPrediction, ManyBlocksMatchPredictBitForBit) {
   const RandomForest forest = DeepForest();
   ASSERT_EQ(forest.num_trees(), 12);
-  // Over two blocks' worth of rows, and a partial lock-step group (of 8) at the end.
+  // Over two blocks' worth of rows, and a partial lock-step group at the end.
   const int block = forest.PredictionBlockRows();
   ASSERT_GE(block, 1024);
   ASSERT_LE(block, 20000) << "this small forest should get small blocks";
