@@ -91,13 +91,18 @@ std::vector<size_t> LocalMaxima(const std::vector<ScoreWindow>& hits, const std:
                                 const std::vector<GridColumn>& columns) {
   std::vector<size_t> kept;
   kept.reserve(hits.size() / 4);
-  // Best score among the hits of column c at grid rows [row - 1, row + 1].
-  const auto best_near = [&](size_t c, int row) {
-    const auto first = rows.begin() + static_cast<std::ptrdiff_t>(column_begin[c]);
-    const auto last = rows.begin() + static_cast<std::ptrdiff_t>(column_begin[c + 1]);
+  // The hits of a column are in row order, so the hits near row r of a column are found by a
+  // cursor that only moves forward as r grows (a binary search per hit and neighbour column
+  // cost more than the rest of the selection).
+  struct Cursor {
+    size_t at = 0, end = 0;
+  };
+  // Best score among the hits from the cursor on at grid rows [row - 1, row + 1].
+  const auto best_near = [&](Cursor& cursor, int row) {
+    while (cursor.at < cursor.end && rows[cursor.at] < row - 1) ++cursor.at;
     float best = 0.f;
-    for (auto it = std::lower_bound(first, last, row - 1); it != last && *it <= row + 1; ++it) {
-      best = std::max(best, hits[static_cast<size_t>(it - rows.begin())].score);
+    for (size_t k = cursor.at; k < cursor.end && rows[k] <= row + 1; ++k) {
+      best = std::max(best, hits[k].score);
     }
     return best;
   };
@@ -105,11 +110,14 @@ std::vector<size_t> LocalMaxima(const std::vector<ScoreWindow>& hits, const std:
     const bool left = column > 0 && columns[column - 1].shape == columns[column].shape;
     const bool right =
         column + 1 < columns.size() && columns[column + 1].shape == columns[column].shape;
+    Cursor own{column_begin[column], column_begin[column + 1]};
+    Cursor before = left ? Cursor{column_begin[column - 1], column_begin[column]} : Cursor{};
+    Cursor after = right ? Cursor{column_begin[column + 1], column_begin[column + 2]} : Cursor{};
     for (size_t i = column_begin[column]; i < column_begin[column + 1]; ++i) {
       const int row = rows[i];
-      float best = best_near(column, row);
-      if (left) best = std::max(best, best_near(column - 1, row));
-      if (right) best = std::max(best, best_near(column + 1, row));
+      float best = best_near(own, row);
+      if (left) best = std::max(best, best_near(before, row));
+      if (right) best = std::max(best, best_near(after, row));
       if (hits[i].score >= best) kept.push_back(i);
     }
   }
