@@ -1,5 +1,9 @@
 #include "core/base/heap_tuning.h"
 
+// <cstdlib> first: __GLIBC__ is defined by the C library's own headers, so testing it before any
+// of them is included (as this file once did) silently compiles the setting out.
+#include <cstdlib>
+
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
