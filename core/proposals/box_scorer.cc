@@ -224,9 +224,8 @@ void BoxScorer::BuildRunIndexes(Tables& t) {
 double BoxScorer::RectSum(const std::vector<double>& integral, int r0, int c0, int r1,
                           int c1) const {
   const size_t stride = static_cast<size_t>(height_) + 1;
-  const size_t left = c0 * stride, right = (c1 + 1) * stride;
-  return integral[right + r1 + 1] - integral[right + r0] - integral[left + r1 + 1] +
-         integral[left + r0];
+  return RectSumOfColumns(integral.data() + c0 * stride, integral.data() + (c1 + 1) * stride, r0,
+                          r1);
 }
 
 void BoxScorer::Score(ScoreWindow& w, float bar) { ScoreImpl(w, bar, true); }
@@ -309,7 +308,7 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
     } else {
       for (const auto& [begin, end] : *tops) scan(begin, end);
     }
-    // Pass 2: v of ScoreAfterBound (RectSum's terms in its order) and its early exit.
+    // Pass 2: v of ScoreAfterBound and its early exit.
     const size_t stride = static_cast<size_t>(height_) + 1;
     const double* const anchor_left = t_->anchor_mag_integral.data() + c0 * stride;
     const double* const anchor_right = t_->anchor_mag_integral.data() + (c1 + 1) * stride;
@@ -319,10 +318,8 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
     for (size_t i = 0; i < reached_.size(); ++i) {
       const int r0 = reached_[i], r1 = r0 + box_height;
       const int inner_r0 = r0 + inner_offset, inner_r1 = inner_r0 + half_h;
-      const double v =
-          (anchor_right[r1 + 1] - anchor_right[r0] - anchor_left[r1 + 1] + anchor_left[r0]) -
-          (edge_right[inner_r1 + 1] - edge_right[inner_r0] - edge_left[inner_r1 + 1] +
-           edge_left[inner_r0]);
+      const double v = RectSumOfColumns(anchor_left, anchor_right, r0, r1) -
+                       RectSumOfColumns(edge_left, edge_right, inner_r0, inner_r1);
       if (!Hopeless(v, norm, bar)) hopeful_.push_back(Hopeful{r0, v});
     }
     // Pass 3: the walks of the windows past the early exit.

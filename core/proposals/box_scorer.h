@@ -119,6 +119,11 @@ class BoxScorer {
   void BuildWalkGraph(Tables& t);
   // Sum over the inclusive rectangle of a column-major (width+1) x (height+1) integral image.
   double RectSum(const std::vector<double>& integral, int r0, int c0, int r1, int c1) const;
+  // The same sum from the integral image's columns c0 (`left`) and c1 + 1 (`right`), for loops
+  // that keep the columns fixed; RectSum is this, so both give the same double.
+  static double RectSumOfColumns(const double* left, const double* right, int r0, int r1) {
+    return right[r1 + 1] - right[r0] - left[r1 + 1] + left[r0];
+  }
   bool AnchoredInside(const Node& n, const ScoreWindow& w) const {
     return n.anchor_x >= w.c0 && n.anchor_x <= w.c1 && n.anchor_y >= w.r0 && n.anchor_y <= w.r1;
   }

@@ -236,17 +236,10 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
   // region scores 2-3.3 x min_score and the refined local maxima at least 2 x, so a bar of
   // 1.5 x settles every region there in one scan, with ~10 % fewer walks. A small grid is unlikely
   // to fill max_boxes at all, and a scan that does not settle is wasted: such grids skip it.
-  long long grid_windows = 0;
-  for (const WindowShape& shape : WindowShapes(scorer.width(), scorer.height(), params)) {
-    const long long columns =
-        (scorer.width() - shape.width + shape.stride_x + shape.stride_x - 1) / shape.stride_x;
-    const long long rows =
-        (scorer.height() - shape.height + shape.stride_y + shape.stride_y - 1) / shape.stride_y;
-    grid_windows += std::max(0LL, columns) * std::max(0LL, rows);
-  }
   const bool bar_applies =
       provisional_bar > 1.f && params.max_boxes > 0 &&
-      grid_windows >= kMinGridWindowsPerBox * params.max_boxes &&
+      CountWindows(scorer.width(), scorer.height(), params) >=
+          kMinGridWindowsPerBox * params.max_boxes &&
       (!params.refine || (params.refine_local_maxima && params.refine_limit > 0));
   if (bar_applies) {
     const EdgeBoxStats before = stats;

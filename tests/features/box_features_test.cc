@@ -264,14 +264,27 @@ TEST(BoxFeaturesTest, ComputeAllMatchesCompute) {
   }
 }
 
+// `edges` edge pixels at random places with values step, 2 step, ... levels step, on random
+// colours.
+struct ScatteredScene {
+  cv::Mat1f map;
+  cv::Mat3b bgr;
+};
+ScatteredScene ScatteredEdges(int rows, int cols, int edges, int levels, float step, cv::RNG& rng) {
+  ScatteredScene scene{cv::Mat1f(rows, cols, 0.f), cv::Mat3b(rows, cols)};
+  for (int i = 0; i < edges; ++i) {
+    scene.map(rng.uniform(0, rows), rng.uniform(0, cols)) =
+        step * static_cast<float>(i % levels + 1);
+  }
+  rng.fill(scene.bgr, cv::RNG::UNIFORM, 0, 256);
+  return scene;
+}
+
 TEST(BoxFeaturesTest, ComputeAllOfScatteredBoxesKeepsInputOrder) {
   // ComputeAll visits the boxes in a spatial order; rows must still follow the input order.
   cv::RNG rng(99);
-  cv::Mat1f map(60, 200, 0.f);
-  for (int i = 0; i < 400; ++i) map(rng.uniform(0, 60), rng.uniform(0, 200)) = 0.1f * (i % 7 + 1);
-  cv::Mat3b bgr(60, 200);
-  rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
-  const BoxFeatureExtractor extractor(map, bgr, {10, 20}, {300, 100});
+  const ScatteredScene scene = ScatteredEdges(60, 200, 400, 7, 0.1f, rng);
+  const BoxFeatureExtractor extractor(scene.map, scene.bgr, {10, 20}, {300, 100});
   std::vector<ScoredBox> proposals;
   for (int i = 0; i < 300; ++i) {
     const int w = rng.uniform(1, 80), h = rng.uniform(1, 40);
@@ -287,11 +300,8 @@ TEST(BoxFeaturesTest, ComputeAllOfScatteredBoxesKeepsInputOrder) {
 
 TEST(BoxFeaturesTest, ComputeIntoWritesTheGivenRows) {
   cv::RNG rng(5);
-  cv::Mat1f map(50, 90, 0.f);
-  for (int i = 0; i < 200; ++i) map(rng.uniform(0, 50), rng.uniform(0, 90)) = 0.125f * (i % 5 + 1);
-  cv::Mat3b bgr(50, 90);
-  rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
-  const BoxFeatureExtractor extractor(map, bgr, {4, 2}, {120, 60});
+  const ScatteredScene scene = ScatteredEdges(50, 90, 200, 5, 0.125f, rng);
+  const BoxFeatureExtractor extractor(scene.map, scene.bgr, {4, 2}, {120, 60});
   std::vector<ScoredBox> proposals;
   std::vector<int> rows;
   for (int i = 0; i < 40; ++i) {
