@@ -44,8 +44,13 @@ struct ObstacleInstance {
   long long pixel_count() const { return cv::countNonZero(mask); }
 };
 
+// What a dataset's `road` mask holds: a labelled drivable surface (LAF free space, MODDv2 water),
+// or, for anomaly-benchmark masks that have no road label, every pixel that is neither obstacle
+// nor void ("not an obstacle": road and the rest of the scene together).
+enum class FreeSpace { kRoadLabel, kNotObstacle };
+
 // One annotated frame, whatever the dataset. Masks are full-frame, 255 = member.
-// road: free space (LAF) or water (MODDv2), obstacles excluded.
+// road: free space (see FreeSpace), obstacles excluded.
 // obstacle: union of obstacle instances. ignore: neither counted as road nor as obstacle.
 struct Sample {
   std::string name;        // stem used for outputs, e.g. "scene_000001_000010"
@@ -55,6 +60,7 @@ struct Sample {
   cv::Mat1b obstacle;
   cv::Mat1b ignore;
   std::vector<ObstacleInstance> instances;
+  FreeSpace free_space = FreeSpace::kRoadLabel;
 };
 
 }  // namespace tod

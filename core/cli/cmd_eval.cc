@@ -22,7 +22,9 @@ Runner AddEvalCommand(CLI::App& app) {
   cmd->add_option("--model", args->model, "model bundle directory")->required();
   cmd->add_option("--split", args->eval.split, "split to evaluate");
   cmd->add_option("--format", args->eval.format, "dataset format")
-      ->check(CLI::IsMember({"auto", "laf", "modd2"}));
+      ->check(CLI::IsMember({"auto", "laf", "masks", "modd2"}));
+  cmd->add_option("--split-file", args->eval.split_file,
+                  "masks format: `train|test <stem>` lines to use instead of DATA/split.txt");
   cmd->add_option("--max-frames", args->eval.max_frames,
                   "evaluate at most this many frames (0 = all)");
   cmd->add_option("--threads", args->eval.threads, "worker threads (0 = all cores)");

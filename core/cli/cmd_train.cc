@@ -29,7 +29,10 @@ Runner AddTrainCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "laf2020"}));
   cmd->add_option("--seed", args->train.seed, "random seed");
   cmd->add_option("--format", args->train.format, "dataset format")
-      ->check(CLI::IsMember({"auto", "laf", "modd2"}));
+      ->check(CLI::IsMember({"auto", "laf", "masks", "modd2"}));
+  cmd->add_option("--split", args->train.split, "split to train on");
+  cmd->add_option("--split-file", args->train.split_file,
+                  "masks format: `train|test <stem>` lines to use instead of DATA/split.txt");
   cmd->add_option("--edge-source", args->train.edge_source, "base edge map")
       ->check(CLI::IsMember({"pixel_forest", "gradient", "sed"}));
   cmd->add_option("--sed-model", args->train.sed_model,
@@ -71,6 +74,7 @@ Runner AddTrainCommand(CLI::App& app) {
     EvalOptions eval;
     eval.data_root = options.data_root;
     eval.format = options.format;
+    eval.split_file = options.split_file;
     eval.split = args->eval_split;
     eval.max_frames = args->eval_frames;
     eval.threads = options.threads;

@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/data/image_file.h"
+
 namespace tod {
 namespace {
 
@@ -165,23 +167,6 @@ struct LafFrame {
   LafSources paths;
 };
 
-// Reads a PNG, distinguishing a missing file from one that exists but does not decode.
-Result<cv::Mat> ReadPng(const std::string& path, int flags, const char* what) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) {
-    return Status::NotFound(std::string(what) + " file not found: " + path);
-  }
-  cv::Mat m;
-  try {
-    m = cv::imread(path, flags);
-  } catch (const cv::Exception& e) {
-    return Status::DataLoss(std::string("cannot decode ") + what + " PNG " + path + ": " +
-                            e.what());
-  }
-  if (m.empty()) return Status::DataLoss(std::string("cannot decode ") + what + " PNG: " + path);
-  return m;
-}
-
 class LafDataset final : public Dataset {
  public:
   explicit LafDataset(std::vector<LafFrame> frames) : frames_(std::move(frames)) {}
@@ -199,13 +184,14 @@ class LafDataset final : public Dataset {
     const LafFrame& frame = frames_[i];
     // IMREAD_COLOR gives BGR 8-bit whatever the PNG holds; the gamma chunk is not applied
     // (ALGORITHM.md §9.1: decode raw values).
-    Result<cv::Mat> image = ReadPng(frame.paths.image, cv::IMREAD_COLOR, "image");
+    Result<cv::Mat> image = ReadImageFile(frame.paths.image, cv::IMREAD_COLOR, "image");
     if (!image.ok()) return image.status();
     // Annotations keep their raw depth: instanceIds is 16-bit, labelIds 8-bit.
     Result<cv::Mat> instance_ids =
-        ReadPng(frame.paths.instance_ids, cv::IMREAD_UNCHANGED, "instanceIds");
+        ReadImageFile(frame.paths.instance_ids, cv::IMREAD_UNCHANGED, "instanceIds");
     if (!instance_ids.ok()) return instance_ids.status();
-    Result<cv::Mat> label_ids = ReadPng(frame.paths.label_ids, cv::IMREAD_UNCHANGED, "labelIds");
+    Result<cv::Mat> label_ids =
+        ReadImageFile(frame.paths.label_ids, cv::IMREAD_UNCHANGED, "labelIds");
     if (!label_ids.ok()) return label_ids.status();
     return BuildSample(cv::Mat3b(*image), *instance_ids, *label_ids, frame.stem, frame.paths);
   }

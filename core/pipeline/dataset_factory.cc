@@ -3,29 +3,42 @@
 #include <algorithm>
 
 #include "core/data/laf_reader.h"
+#include "core/data/masks_reader.h"
 #include "core/modd2/modd2_reader.h"
 
 namespace tod {
 
 Result<std::string> DetectDatasetFormat(const std::string& root) {
   if (LooksLikeLaf(root)) return std::string("laf");
+  if (LooksLikeMasks(root)) return std::string("masks");
   if (LooksLikeModd2(root)) return std::string("modd2");
   return Status::NotFound(root +
-                          ": neither the Lost and Found layout (leftImg8bit/, gtCoarse/) nor the "
-                          "MODDv2 layout (video_data/, annotationsV2/); use --format");
+                          ": neither the Lost and Found layout (leftImg8bit/, gtCoarse/), the "
+                          "obstacle-mask layout (images/, labels_masks/) nor the MODDv2 layout "
+                          "(video_data/, annotationsV2/); use --format");
 }
 
-Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& root, const std::string& split,
-                                             const std::string& format) {
-  std::string chosen = format;
-  if (chosen == "auto") {
-    auto detected = DetectDatasetFormat(root);
-    if (!detected.ok()) return detected.status();
-    chosen = *detected;
+namespace {
+
+Result<std::string> ResolveFormat(const DatasetSpec& spec) {
+  if (spec.format == "auto") return DetectDatasetFormat(spec.root);
+  if (spec.format == "laf" || spec.format == "masks" || spec.format == "modd2") return spec.format;
+  return Status::InvalidArgument("unknown dataset format '" + spec.format +
+                                 "' (auto, laf, masks, modd2)");
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Dataset>> OpenDataset(const DatasetSpec& spec) {
+  auto format = ResolveFormat(spec);
+  if (!format.ok()) return format.status();
+  if (!spec.split_file.empty() && *format != "masks") {
+    return Status::InvalidArgument("--split-file applies to the masks format only (" + spec.root +
+                                   " is " + *format + ")");
   }
-  if (chosen == "laf") return OpenLafDataset(root, split);
-  if (chosen == "modd2") return OpenModd2Dataset(root, split);
-  return Status::InvalidArgument("unknown dataset format '" + format + "' (auto, laf, modd2)");
+  if (*format == "laf") return OpenLafDataset(spec.root, spec.split);
+  if (*format == "masks") return OpenMasksDataset(spec.root, spec.split, spec.split_file);
+  return OpenModd2Dataset(spec.root, spec.split);
 }
 
 std::vector<int> SpreadIndices(int total, int count) {
@@ -35,21 +48,20 @@ std::vector<int> SpreadIndices(int total, int count) {
   return out;
 }
 
-Result<FrameSelection> SelectFrames(const std::string& root, const std::string& split,
-                                    const std::string& format, int max_frames) {
-  FrameSelection out;
-  out.format = format;
-  if (out.format == "auto") {
-    auto detected = DetectDatasetFormat(root);
-    if (!detected.ok()) return detected.status();
-    out.format = *detected;
-  }
-  auto dataset = OpenDataset(root, split, out.format);
+Result<FrameSelection> SelectFrames(const DatasetSpec& spec) {
+  auto format = ResolveFormat(spec);
+  if (!format.ok()) return format.status();
+  DatasetSpec resolved = spec;
+  resolved.format = *format;
+  auto dataset = OpenDataset(resolved);
   if (!dataset.ok()) return dataset.status();
+  FrameSelection out;
+  out.format = *format;
   out.dataset = std::move(*dataset);
   const int total = static_cast<int>(out.dataset->size());
-  if (total == 0) return Status::InvalidArgument(root + ": the " + split + " split is empty");
-  out.frames = SpreadIndices(total, max_frames);
+  if (total == 0)
+    return Status::InvalidArgument(spec.root + ": the " + spec.split + " split is empty");
+  out.frames = SpreadIndices(total, spec.max_frames);
   return out;
 }
 

@@ -1,5 +1,6 @@
 // Opens a dataset split by format: "laf" (Lost and Found layout, also `tod synth` output),
-// "modd2" (MODDv2), or "auto" (detected from the layout).
+// "masks" (obstacle benchmark masks: images/ + labels_masks/), "modd2" (MODDv2), or "auto"
+// (detected from the layout).
 #pragma once
 
 #include <memory>
@@ -10,8 +11,16 @@
 
 namespace tod {
 
-Result<std::unique_ptr<Dataset>> OpenDataset(const std::string& root, const std::string& split,
-                                             const std::string& format = "auto");
+// Which frames of which dataset.
+struct DatasetSpec {
+  std::string root;
+  std::string split = "train";
+  std::string format = "auto";  // auto, laf, masks, modd2
+  std::string split_file;       // masks only: instead of <root>/split.txt
+  int max_frames = 0;           // at most this many, spread evenly over the split (0 = all)
+};
+
+Result<std::unique_ptr<Dataset>> OpenDataset(const DatasetSpec& spec);
 
 // At most `count` indices of [0, total) spread evenly, ascending (all of them when count <= 0 or
 // count >= total), so a subset still covers every scene.
@@ -21,13 +30,12 @@ std::vector<int> SpreadIndices(int total, int count);
 // max_frames spread evenly over the split (so a subset still covers every scene).
 struct FrameSelection {
   std::unique_ptr<Dataset> dataset;
-  std::string format;       // resolved: "laf" or "modd2"
+  std::string format;       // resolved: "laf", "masks" or "modd2"
   std::vector<int> frames;  // indices into dataset, ascending, never empty
 };
-Result<FrameSelection> SelectFrames(const std::string& root, const std::string& split,
-                                    const std::string& format, int max_frames);
+Result<FrameSelection> SelectFrames(const DatasetSpec& spec);
 
-// "laf", "modd2", or an error naming what was looked for.
+// "laf", "masks", "modd2", or an error naming what was looked for.
 Result<std::string> DetectDatasetFormat(const std::string& root);
 
 }  // namespace tod

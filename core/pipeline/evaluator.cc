@@ -56,8 +56,8 @@ std::string Fixed(double v, int digits = 3) {
 }  // namespace
 
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options) {
-  auto selection =
-      SelectFrames(options.data_root, options.split, options.format, options.max_frames);
+  auto selection = SelectFrames(
+      {options.data_root, options.split, options.format, options.split_file, options.max_frames});
   if (!selection.ok()) return selection.status();
   const Dataset& dataset = *selection->dataset;
   const int n = static_cast<int>(selection->frames.size());

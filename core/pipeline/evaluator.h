@@ -19,7 +19,8 @@ struct EvalOptions {
   std::string data_root;
   std::string format = "auto";
   std::string split = "test";
-  int max_frames = 0;  // 0 = all
+  std::string split_file;  // masks: instead of <data_root>/split.txt
+  int max_frames = 0;      // 0 = all
   int threads = 0;
   std::function<void(const std::string&)> progress;
 };

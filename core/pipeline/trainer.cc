@@ -48,8 +48,8 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
     if (options.progress) options.progress(line);
   };
   const auto started = Clock::now();
-  auto selection =
-      SelectFrames(options.data_root, options.split, options.format, options.max_frames);
+  auto selection = SelectFrames(
+      {options.data_root, options.split, options.format, options.split_file, options.max_frames});
   if (!selection.ok()) return selection.status();
   const Dataset& dataset = *selection->dataset;
   const std::string& format = selection->format;

@@ -17,8 +17,9 @@ namespace tod {
 
 struct TrainOptions {
   std::string data_root;
-  std::string format = "auto";  // auto | laf | modd2
+  std::string format = "auto";  // auto | laf | masks | modd2
   std::string split = "train";
+  std::string split_file;                    // masks: instead of <data_root>/split.txt
   std::string regions = "auto";              // auto (k-means on the training obstacles) | laf2020
   std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
   std::string sed_model;                     // model file for edge_source "sed"
