@@ -13,6 +13,7 @@ Runner AddEvalCommand(CLI::App& app) {
   struct Args {
     EvalOptions eval;
     std::string model, json, plots;
+    std::string on_bad_frame = "fail";
     bool record = false;
   };
   auto args = std::make_shared<Args>();
@@ -28,6 +29,9 @@ Runner AddEvalCommand(CLI::App& app) {
   cmd->add_option("--max-frames", args->eval.max_frames,
                   "evaluate at most this many frames (0 = all)");
   cmd->add_option("--threads", args->eval.threads, "worker threads (0 = all cores)");
+  cmd->add_option("--on-bad-frame", args->on_bad_frame,
+                  "fail: stop at an unreadable frame; skip: leave it out, list and count it")
+      ->check(CLI::IsMember({"fail", "skip"}));
   cmd->add_option("--json", args->json, "write the numbers as JSON to this file");
   cmd->add_option("--plots", args->plots, "draw the paper's curves as PNG into this directory");
   cmd->add_flag("--record", args->record,
@@ -36,6 +40,7 @@ Runner AddEvalCommand(CLI::App& app) {
     auto bundle = LoadModelBundle(args->model);
     if (!bundle.ok()) return Fail(bundle.status().message());
     EvalOptions options = args->eval;
+    options.on_bad_frame = *ParseBadFramePolicy(args->on_bad_frame);  // checked by CLI11
     options.progress = [](const std::string& line) { std::cerr << "eval: " << line << "\n"; };
     auto report = EvaluateModel(*bundle, options);
     if (!report.ok()) return Fail(report.status().message());

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   add(tod::cli::AddTrainCommand);
   add(tod::cli::AddDetectCommand);
   add(tod::cli::AddEvalCommand);
+  add(tod::cli::AddAnalyseCommand);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

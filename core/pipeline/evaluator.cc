@@ -70,15 +70,11 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   std::map<std::string, std::vector<double>> stage_ms;
   std::vector<std::string> stage_order;
   std::mutex mutex;
-  std::vector<Status> errors(n);
   int done = 0;
 
-  ParallelFor(n, options.threads, [&](int i) {
+  const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
     auto loaded = dataset.Load(selection->frames[i]);
-    if (!loaded.ok()) {
-      errors[i] = loaded.status();
-      return;
-    }
+    if (!loaded.ok()) return loaded.status();
     const Sample& s = *loaded;
     const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
     const int layers = geo.regions.num_layers();
@@ -158,12 +154,14 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     ++done;
     if (options.progress && (done % 10 == 0 || done == n))
       options.progress("evaluated " + std::to_string(done) + "/" + std::to_string(n) + " frames");
+    return Status::Ok();
   });
-  for (const Status& e : errors)
-    if (!e.ok()) return e;
-
   EvalReport report;
-  report.frames = n;
+  const Status bad = ApplyBadFramePolicy(
+      per_frame, [&](int i) { return dataset.name(selection->frames[i]); }, options.on_bad_frame,
+      &report.skipped);
+  if (!bad.ok()) return bad;
+  report.frames = n - static_cast<int>(report.skipped.size());
   report.instances = recall.at("EB").instances();
   for (const auto& v : ProposalVariants()) report.proposals[v] = Curves(recall.at(v));
   for (const auto& v : RegressionVariants()) {
@@ -181,6 +179,7 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
   nlohmann::json j;
   j["frames"] = r.frames;
   j["instances"] = r.instances;
+  j["skipped_frames"] = SkippedFramesToJson(r.skipped);
   auto ar = [](const VariantCurves& c) {
     nlohmann::json a = nlohmann::json::object();
     for (const auto& [n, v] : c.ar_table) a[std::to_string(n)] = v;
@@ -201,7 +200,10 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
 
 std::string FormatEvalTables(const EvalReport& r) {
   std::ostringstream o;
-  o << "frames " << r.frames << ", obstacle instances " << r.instances << "\n\n";
+  o << "frames " << r.frames << ", obstacle instances " << r.instances << "\n";
+  for (const SkippedFrame& f : r.skipped)
+    o << "skipped frame " << f.frame << ": " << f.reason << "\n";
+  o << "\n";
   o << "Average recall (proposals)\n";
   char line[256];
   std::snprintf(line, sizeof line, "%-16s %7s %7s %7s %7s %7s\n", "variant", "200", "400", "600",

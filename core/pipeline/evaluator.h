@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/metrics/pixel_roc.h"
+#include "core/pipeline/bad_frames.h"
 #include "core/pipeline/model_bundle.h"
 
 namespace tod {
@@ -22,6 +23,7 @@ struct EvalOptions {
   std::string split_file;  // masks: instead of <data_root>/split.txt
   int max_frames = 0;      // 0 = all
   int threads = 0;
+  BadFramePolicy on_bad_frame = BadFramePolicy::kFail;
   std::function<void(const std::string&)> progress;
 };
 
@@ -45,7 +47,8 @@ struct VariantCurves {
 };
 
 struct EvalReport {
-  int frames = 0;
+  int frames = 0;  // evaluated (skipped ones not counted)
+  std::vector<SkippedFrame> skipped;
   int instances = 0;
   std::map<std::string, VariantCurves> proposals;   // proposal variants
   std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)

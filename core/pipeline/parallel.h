@@ -3,27 +3,17 @@
 // outcome does not depend on the thread count.
 #pragma once
 
-#include <algorithm>
-#include <atomic>
 #include <functional>
-#include <thread>
 #include <vector>
+
+#include "core/base/status.h"
 
 namespace tod {
 
-inline void ParallelFor(int count, int threads, const std::function<void(int)>& body) {
-  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::min(threads, count);
-  if (threads <= 1) {
-    for (int i = 0; i < count; ++i) body(i);
-    return;
-  }
-  std::atomic<int> next{0};
-  std::vector<std::jthread> pool;
-  for (int t = 0; t < threads; ++t)
-    pool.emplace_back([&] {
-      for (int i = next++; i < count; i = next++) body(i);
-    });
-}
+// Runs body(i) for every i in [0, count) on up to `threads` threads (0 = all cores) and returns
+// one Status per index: what body returned, or Internal naming the exception body threw. An
+// exception in one frame thus becomes that frame's error, never std::terminate, and the other
+// frames still run.
+std::vector<Status> ParallelFor(int count, int threads, const std::function<Status(int)>& body);
 
 }  // namespace tod

@@ -59,13 +59,11 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   // 1. Read the split (kept in memory: every later step visits every frame).
   say("reading " + std::to_string(n) + " training frames from " + options.data_root);
   std::vector<Sample> frames(n);
-  std::vector<Status> errors(n);
-  ParallelFor(n, options.threads, [&](int i) {
+  const std::vector<Status> errors = ParallelFor(n, options.threads, [&](int i) -> Status {
     auto s = dataset.Load(frame_ids[i]);
-    if (s.ok())
-      frames[i] = std::move(*s);
-    else
-      errors[i] = s.status();
+    if (!s.ok()) return s.status();
+    frames[i] = std::move(*s);
+    return Status::Ok();
   });
   for (const Status& e : errors)
     if (!e.ok()) return e;
@@ -139,12 +137,13 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   // 4. Occlusion classifier on superpixel boundaries (§3.4 steps 2-5).
   t0 = Clock::now();
   std::vector<OcclusionTrainingFrame> occlusion_frames(classifier_ids.size());
-  ParallelFor(static_cast<int>(classifier_ids.size()), options.threads, [&](int j) {
+  (void)ParallelFor(static_cast<int>(classifier_ids.size()), options.threads, [&](int j) {
     const Sample& s = frames[classifier_ids[j]];
     OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges, nullptr,
                                                  bundle.params.superpixels, /*enhance=*/true);
     occlusion_frames[j] = {oaocc.crop.clone(), oaocc.enhanced, oaocc.superpixels,
                            LabelMap(s)(oaocc.r1.rect()).clone()};
+    return Status::Ok();
   });
   OcclusionParams occlusion_params = options.occlusion_params;
   occlusion_params.forest.seed = options.seed;
@@ -162,7 +161,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   std::vector<long long> proposal_counts(n, 0);
   std::atomic<int> done{0};
   std::mutex say_mutex;
-  ParallelFor(n, options.threads, [&](int i) {
+  (void)ParallelFor(n, options.threads, [&](int i) {
     const Sample& s = frames[i];
     if (cv::countNonZero(s.road) > 0) {
       const OcclusionEdges oaocc =
@@ -192,6 +191,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
       say("proposals and samples: " + std::to_string(finished) + "/" + std::to_string(n) +
           " frames");
     }
+    return Status::Ok();
   });
   auto stack = [](const std::vector<cv::Mat1f>& parts,
                   const std::vector<std::vector<float>>& targets, cv::Mat1f& rows,

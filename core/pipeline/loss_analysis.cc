@@ -1,0 +1,260 @@
+#include "core/pipeline/loss_analysis.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <mutex>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <sstream>
+
+#include "core/features/sample_selection.h"
+#include "core/pipeline/dataset_factory.h"
+#include "core/pipeline/obstacle_detector.h"
+#include "core/pipeline/parallel.h"
+
+namespace tod {
+namespace {
+
+constexpr float kEdgeOn = 0.1f;  // Edge Boxes' edgeMinMag: weaker pixels are not edges (§4.2)
+
+// Share of the instance's contour pixels (mask pixels with a 4-neighbour outside the mask) that
+// have an edge pixel of `map` (R1-crop coordinates) within one pixel.
+double ContourCoverage(const ObstacleInstance& inst, const cv::Mat1b& edge_near, const Box& r1) {
+  cv::Mat1b padded;
+  cv::copyMakeBorder(inst.mask, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
+  long long contour = 0, covered = 0;
+  for (int y = 0; y < inst.box.h; ++y) {
+    for (int x = 0; x < inst.box.w; ++x) {
+      if (!padded(y + 1, x + 1)) continue;
+      if (padded(y, x + 1) && padded(y + 2, x + 1) && padded(y + 1, x) && padded(y + 1, x + 2))
+        continue;
+      ++contour;
+      const int cx = inst.box.x + x - r1.x, cy = inst.box.y + y - r1.y;
+      if (cx >= 0 && cy >= 0 && cx < edge_near.cols && cy < edge_near.rows && edge_near(cy, cx))
+        ++covered;
+    }
+  }
+  return contour > 0 ? static_cast<double>(covered) / contour : 0.0;
+}
+
+cv::Mat1b EdgesDilatedByOne(const cv::Mat1f& map) {
+  cv::Mat1b on = map > kEdgeOn;
+  cv::dilate(on, on, cv::Mat1b::ones(3, 3));
+  return on;
+}
+
+double BestIoU(const std::vector<ScoredBox>& boxes, const Box& gt) {
+  double best = 0;
+  for (const ScoredBox& b : boxes) best = std::max(best, BoxIoU(b.box, gt));
+  return best;
+}
+
+int FirstHit(const std::vector<Box>& ranked, const Box& gt, double iou, int top_n) {
+  const int n = std::min<int>(top_n, static_cast<int>(ranked.size()));
+  for (int r = 0; r < n; ++r)
+    if (BoxIoU(ranked[r], gt) >= iou) return r;
+  return -1;
+}
+
+double Share(const cv::Mat1f& map) {
+  return map.empty() ? 0.0 : static_cast<double>(cv::countNonZero(map > kEdgeOn)) / map.total();
+}
+
+struct FrameResult {
+  FrameWork work;
+  std::vector<ObstacleFate> fates;
+};
+
+FrameResult AnalyseFrame(const ModelBundle& bundle, const Sample& s,
+                         const LossAnalysisOptions& options) {
+  FrameResult out;
+  const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
+  const OcclusionEdges oaocc =
+      ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion,
+                            bundle.params.superpixels, /*enhance=*/true);
+  const int layers = geo.regions.num_layers();
+  std::vector<ScoredBox> unfiltered;
+  std::vector<std::vector<ScoredBox>> filtered(layers);
+  const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
+  for (int k = 0; k < layers; ++k) {
+    const auto all = ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k,
+                                        bundle.params.multistride, nullptr);
+    unfiltered.insert(unfiltered.end(), all.begin(), all.end());
+    filtered[k] = filter ? ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k,
+                                              bundle.params.multistride, filter)
+                         : all;
+  }
+  ProposalSet merged = MergeRegionBoxes(filtered);
+  std::vector<Box> by_objectness;
+  for (const ScoredBox& b : merged.boxes) by_objectness.push_back(b.box);
+  const RegressedProposals reg =
+      RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(merged));
+  const std::vector<float> fused = FuseScores(reg.ordr, reg.obdr, bundle.params.fusion);
+  std::vector<int> order(fused.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return fused[a] > fused[b]; });
+  std::vector<Box> by_fused;
+  for (int i : order) by_fused.push_back(reg.proposals.boxes[i].box);
+
+  out.work.frame = s.name;
+  out.work.base_edge_density = Share(oaocc.base_edge);
+  out.work.occlusion_density = Share(oaocc.occlusion);
+  out.work.superpixels = oaocc.superpixels.count;
+  out.work.proposals = static_cast<long long>(by_objectness.size());
+  for (int k = 0; k < layers; ++k) {
+    EdgeBoxStats stats;
+    EdgeBoxParams params = bundle.params.boxes;
+    params.refine = false;  // counting windows only
+    const cv::Mat1f map = RegionEdgeMap(oaocc, geo.regions, k);
+    if (map.empty()) continue;
+    params.stride_factor =
+        bundle.params.multistride ? static_cast<float>(layers - k) / layers : 1.f;
+    const Box region = Intersect(geo.regions.layers[k], oaocc.r1);
+    std::optional<WindowAdmission> admission;
+    if (filter && filter->enabled) admission.emplace(*filter, region.y);
+    ScoreEdgeBoxes(NormaliseToMax(map), params, &stats, admission ? &*admission : nullptr);
+    out.work.windows_scored += stats.windows_visited;
+  }
+
+  const cv::Mat1b base_near = EdgesDilatedByOne(oaocc.base_edge);
+  const cv::Mat1b occlusion_near = EdgesDilatedByOne(oaocc.occlusion);
+  const std::vector<int> limits = geo.regions.RangeLimits();
+  for (const ObstacleInstance& inst : s.instances) {
+    ObstacleFate f;
+    f.frame = s.name;
+    f.box = inst.box;
+    f.pixels = inst.pixel_count();
+    f.range = VerticalRangeIndex(BottomRow(inst.box), limits);
+    f.in_r1 = Intersect(inst.box, oaocc.r1) == inst.box;
+    f.contour_base_edges = ContourCoverage(inst, base_near, oaocc.r1);
+    f.contour_occlusion = ContourCoverage(inst, occlusion_near, oaocc.r1);
+    f.best_iou_unfiltered = BestIoU(unfiltered, inst.box);
+    double best_filtered = 0;
+    for (const auto& region_boxes : filtered)
+      best_filtered = std::max(best_filtered, BestIoU(region_boxes, inst.box));
+    f.best_iou_filtered = best_filtered;
+    f.proposal_rank = FirstHit(by_objectness, inst.box, options.hit_iou, options.top_n);
+    f.regressed_rank = FirstHit(by_fused, inst.box, options.hit_iou, options.top_n);
+    out.fates.push_back(f);
+  }
+  return out;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+Result<LossAnalysis> AnalyseLosses(const ModelBundle& bundle, const LossAnalysisOptions& options) {
+  auto selection = SelectFrames(
+      {options.data_root, options.split, options.format, options.split_file, options.max_frames});
+  if (!selection.ok()) return selection.status();
+  const int n = static_cast<int>(selection->frames.size());
+  std::vector<FrameResult> results(n);
+  std::mutex mutex;
+  int done = 0;
+  const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
+    auto sample = selection->dataset->Load(selection->frames[i]);
+    if (!sample.ok()) return sample.status();
+    results[i] = AnalyseFrame(bundle, *sample, options);
+    std::lock_guard lock(mutex);
+    ++done;
+    if (options.progress && (done % 5 == 0 || done == n))
+      options.progress("analysed " + std::to_string(done) + "/" + std::to_string(n) + " frames");
+    return Status::Ok();
+  });
+  for (int i = 0; i < n; ++i)
+    if (!per_frame[i].ok())
+      return per_frame[i].WithContext("frame " + selection->dataset->name(selection->frames[i]));
+  LossAnalysis out;
+  for (FrameResult& r : results) {
+    out.frames.push_back(r.work);
+    out.obstacles.insert(out.obstacles.end(), r.fates.begin(), r.fates.end());
+  }
+  return out;
+}
+
+std::string FormatLossAnalysis(const LossAnalysis& a, const LossAnalysisOptions& options) {
+  struct Band {
+    const char* name;
+    int min_h, max_h;
+  };
+  const std::vector<Band> bands = {{"all", 0, 1 << 30},
+                                   {"h < 20 px", 0, 19},
+                                   {"h 20-49 px", 20, 49},
+                                   {"h >= 50 px", 50, 1 << 30}};
+  std::ostringstream o;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "Where obstacles are lost (share found at box IoU >= %.2f; top %d)\n",
+                options.hit_iou, options.top_n);
+  o << line;
+  std::snprintf(line, sizeof line, "%-12s %5s %8s %8s %9s %9s %9s %9s\n", "obstacles", "n",
+                "E cont.", "OCC cont.", "any box", "filtered", "top obj", "top reg");
+  o << line;
+  for (const Band& b : bands) {
+    int n = 0, any = 0, kept = 0, top = 0, reg = 0;
+    double base = 0, occ = 0;
+    for (const ObstacleFate& f : a.obstacles) {
+      if (f.box.h < b.min_h || f.box.h > b.max_h) continue;
+      ++n;
+      base += f.contour_base_edges;
+      occ += f.contour_occlusion;
+      any += f.best_iou_unfiltered >= options.hit_iou;
+      kept += f.best_iou_filtered >= options.hit_iou;
+      top += f.proposal_rank >= 0;
+      reg += f.regressed_rank >= 0;
+    }
+    const double d = std::max(1, n);
+    std::snprintf(line, sizeof line, "%-12s %5d %8.2f %8.2f %9.2f %9.2f %9.2f %9.2f\n", b.name, n,
+                  base / d, occ / d, any / d, kept / d, top / d, reg / d);
+    o << line;
+  }
+  std::vector<double> base, occ, sp, windows, proposals;
+  for (const FrameWork& w : a.frames) {
+    base.push_back(w.base_edge_density);
+    occ.push_back(w.occlusion_density);
+    sp.push_back(w.superpixels);
+    windows.push_back(static_cast<double>(w.windows_scored));
+    proposals.push_back(static_cast<double>(w.proposals));
+  }
+  std::snprintf(line, sizeof line,
+                "\nFrames %zu (medians): E > 0.1 on %.1f %% of R1, occlusion edges > 0.1 on %.1f "
+                "%%, %.0f superpixels, %.2f M windows scored, %.0f proposals\n",
+                a.frames.size(), 100 * Median(base), 100 * Median(occ), Median(sp),
+                Median(windows) / 1e6, Median(proposals));
+  o << line;
+  return o.str();
+}
+
+nlohmann::json LossAnalysisToJson(const LossAnalysis& a) {
+  nlohmann::json j;
+  j["obstacles"] = nlohmann::json::array();
+  for (const ObstacleFate& f : a.obstacles)
+    j["obstacles"].push_back({{"frame", f.frame},
+                              {"box", {f.box.x, f.box.y, f.box.w, f.box.h}},
+                              {"pixels", f.pixels},
+                              {"range", f.range},
+                              {"in_r1", f.in_r1},
+                              {"contour_base_edges", f.contour_base_edges},
+                              {"contour_occlusion", f.contour_occlusion},
+                              {"best_iou_unfiltered", f.best_iou_unfiltered},
+                              {"best_iou_filtered", f.best_iou_filtered},
+                              {"proposal_rank", f.proposal_rank},
+                              {"regressed_rank", f.regressed_rank}});
+  j["frames"] = nlohmann::json::array();
+  for (const FrameWork& w : a.frames)
+    j["frames"].push_back({{"frame", w.frame},
+                           {"base_edge_density", w.base_edge_density},
+                           {"occlusion_density", w.occlusion_density},
+                           {"superpixels", w.superpixels},
+                           {"windows_scored", w.windows_scored},
+                           {"proposals", w.proposals}});
+  return j;
+}
+
+}  // namespace tod
