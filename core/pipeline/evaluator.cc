@@ -1,6 +1,7 @@
 #include "core/pipeline/evaluator.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
 #include <opencv2/ximgproc/edgeboxes.hpp>
@@ -53,6 +54,12 @@ std::string Fixed(double v, int digits = 3) {
   return buf;
 }
 
+// An undefined metric (NaN) is null in the JSON rather than a number a reader might average.
+nlohmann::json NumberOrNull(double v) {
+  if (std::isnan(v)) return nullptr;
+  return v;
+}
+
 }  // namespace
 
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options) {
@@ -67,6 +74,9 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   for (const auto& v : RegressionVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
   std::map<std::string, PixelRocAccumulator> roc;
   for (const auto& v : RegressionVariants()) roc.emplace(v, PixelRocAccumulator());
+  std::map<std::string, PixelHistogramAccumulator> served_map_histograms;  // AP, FPR95
+  for (const auto& v : RegressionVariants())
+    served_map_histograms.emplace(v, PixelHistogramAccumulator());
   std::map<std::string, std::vector<double>> stage_ms;
   std::vector<std::string> stage_order;
   std::mutex mutex;
@@ -146,6 +156,9 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     roc.at("OP+ORDR@4").Add(map_op_ordr, s.obstacle, s.road);
     roc.at("BP+ORDR@4").Add(map_bp_ordr, s.obstacle, s.road);
     roc.at("BP+Fusion@4").Add(map_fusion, s.obstacle, s.road);
+    served_map_histograms.at("OP+ORDR@4").Add(map_op_ordr, s.obstacle, s.road);
+    served_map_histograms.at("BP+ORDR@4").Add(map_bp_ordr, s.obstacle, s.road);
+    served_map_histograms.at("BP+Fusion@4").Add(map_fusion, s.obstacle, s.road);
     for (const auto& [stage, ms] : timer.times()) {
       if (!stage_ms.count(stage)) stage_order.push_back(stage);
       stage_ms[stage].push_back(ms);
@@ -168,6 +181,10 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     report.regression[v] = Curves(recall.at(v));
     report.roc[v] = roc.at(v).Curve();
     for (double fpr : TableFprs()) report.tpr_at_fpr[v][fpr] = TprAtFpr(report.roc[v], fpr);
+    const PixelHistogramAccumulator& histograms = served_map_histograms.at(v);
+    report.average_precision[v] = histograms.Ap();
+    report.fpr_at_tpr95[v] = histograms.FprAtTpr(0.95);
+    report.precision_recall[v] = histograms.PrCurve();
   }
   stage_order.push_back("total");
   for (const auto& stage : stage_order)
@@ -191,7 +208,10 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
   for (const auto& v : RegressionVariants()) {
     nlohmann::json tpr = nlohmann::json::object();
     for (const auto& [fpr, t] : r.tpr_at_fpr.at(v)) tpr[Fixed(fpr)] = t;
-    j["regression"][v] = {{"tpr_at_fpr", tpr}, {"ar", ar(r.regression.at(v))}};
+    j["regression"][v] = {{"tpr_at_fpr", tpr},
+                          {"ar", ar(r.regression.at(v))},
+                          {"ap", NumberOrNull(r.average_precision.at(v))},
+                          {"fpr_at_tpr95", NumberOrNull(r.fpr_at_tpr95.at(v))}};
   }
   j["timing_ms"] = nlohmann::json::object();
   for (const auto& [stage, ms] : r.stage_median_ms) j["timing_ms"][stage] = ms;
@@ -227,6 +247,16 @@ std::string FormatEvalTables(const EvalReport& r) {
     o << line;
     for (double f : TableFprs()) o << "   " << Fixed(r.tpr_at_fpr.at(v).at(f));
     o << "\n";
+  }
+  o << "\nPixel AP and FPR at 95 % TPR (8-bit map, regression)\n";
+  std::snprintf(line, sizeof line, "%-16s %7s %7s\n", "variant", "AP", "FPR95");
+  o << line;
+  const auto defined = [](double v) { return std::isnan(v) ? std::string("n/a") : Fixed(v); };
+  for (const auto& v : RegressionVariants()) {
+    std::snprintf(line, sizeof line, "%-16s %7s %7s\n", v.c_str(),
+                  defined(r.average_precision.at(v)).c_str(),
+                  defined(r.fpr_at_tpr95.at(v)).c_str());
+    o << line;
   }
   o << "\nAverage recall (regressed, score > 0.25)\n";
   for (const auto& v : RegressionVariants()) ar_row(v, r.regression.at(v));

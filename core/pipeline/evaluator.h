@@ -1,6 +1,7 @@
 // `tod eval`: the paper's two tables on a dataset split (ALGORITHM.md §8) for the variants
 //   proposals:  EB, OLP@1, OAOCC+OLP@1, OAOCC+OLP@4, OAOCC+OLP@4+MS   (average recall)
 //   regression: OP+ORDR@4, BP+ORDR@4, BP+Fusion@4   (TPR at FPR, average recall)
+// and, for the regression variants, the anomaly-segmentation metrics (pixel AP, FPR at 95 % TPR)
 // plus the median time of each stage per frame.
 #pragma once
 
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/metrics/pixel_histogram_metrics.h"
 #include "core/metrics/pixel_roc.h"
 #include "core/pipeline/bad_frames.h"
 #include "core/pipeline/model_bundle.h"
@@ -54,13 +56,19 @@ struct EvalReport {
   std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)
   std::map<std::string, RocCurve> roc;              // regression variants
   std::map<std::string, std::map<double, double>> tpr_at_fpr;
+  // On the served 8-bit map (core/metrics/pixel_histogram_metrics.h), regression variants:
+  // NaN when undefined (no obstacle pixel; for FPR also no free-space pixel).
+  std::map<std::string, double> average_precision;
+  std::map<std::string, double> fpr_at_tpr95;
+  std::map<std::string, PrecisionRecallCurve> precision_recall;
   std::vector<std::pair<std::string, double>> stage_median_ms;  // detector stages + "total"
 };
 
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options);
 
 // The JSON of the issue: {"frames","instances","proposals":{V:{"ar":{...}}},
-// "regression":{V:{"tpr_at_fpr":{...},"ar":{...}}},"timing_ms":{STAGE:x,...,"total":x}}.
+// "regression":{V:{"tpr_at_fpr":{...},"ar":{...},"ap":x,"fpr_at_tpr95":x}},
+// "timing_ms":{STAGE:x,...,"total":x}}; an undefined "ap" / "fpr_at_tpr95" is null.
 nlohmann::json EvalReportToJson(const EvalReport& report);
 // The two tables and the timing table as text.
 std::string FormatEvalTables(const EvalReport& report);

@@ -1,5 +1,6 @@
 #include "core/pipeline/plots.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -16,6 +17,29 @@ std::string Tick(double v) {
   std::snprintf(buf, sizeof buf,
                 v == static_cast<long long>(v) && std::abs(v) >= 1 ? "%.0f" : "%.2f", v);
   return buf;
+}
+
+// "AP 0.512", or "AP n/a" when undefined (no obstacle pixel).
+std::string ApLabel(double ap) {
+  if (std::isnan(ap)) return "AP n/a";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "AP %.3f", ap);
+  return buf;
+}
+
+// The precision-recall curve drawn as the step function AP integrates: each operating point's
+// precision held from the previous recall to its own. Straight segments between the points would
+// suggest precision values no threshold of the 8-bit map gives (most visibly the long diagonal to
+// recall 1 at t = 0, where all the pixels the map leaves at zero come in at once).
+PlotSeries PrecisionRecallSteps(const std::string& label, const PrecisionRecallCurve& curve) {
+  PlotSeries steps{label, {}, {}};
+  double previous_recall = 0.0;
+  for (std::size_t i = 0; i < curve.recall.size() && i < curve.precision.size(); ++i) {
+    steps.x.insert(steps.x.end(), {previous_recall, curve.recall[i]});
+    steps.y.insert(steps.y.end(), {curve.precision[i], curve.precision[i]});
+    previous_recall = curve.recall[i];
+  }
+  return steps;
 }
 
 }  // namespace
@@ -73,7 +97,7 @@ Status WriteEvalPlots(const EvalReport& report, const std::string& dir) {
   auto to_double = [](const std::vector<int>& v) {
     return std::vector<double>(v.begin(), v.end());
   };
-  std::vector<PlotSeries> at07, at1000, ar, roc;
+  std::vector<PlotSeries> at07, at1000, ar, roc, pr;
   auto add = [&](const std::string& name, const VariantCurves& c) {
     at07.push_back({name, to_double(c.n_grid), c.recall_at_07});
     at1000.push_back({name, c.iou_grid, c.recall_at_1000});
@@ -83,6 +107,9 @@ Status WriteEvalPlots(const EvalReport& report, const std::string& dir) {
   for (const auto& v : RegressionVariants()) {
     add(v, report.regression.at(v));
     roc.push_back({v, report.roc.at(v).fpr, report.roc.at(v).tpr});
+    // The legend carries the AP, the area under the step curve.
+    pr.push_back(PrecisionRecallSteps(v + " (" + ApLabel(report.average_precision.at(v)) + ")",
+                                      report.precision_recall.at(v)));
   }
   const std::vector<std::pair<std::string, cv::Mat3b>> charts = {
       {"recall_vs_proposals.png", RenderLineChart({"Recall vs proposals (IoU 0.7)",
@@ -96,7 +123,10 @@ Status WriteEvalPlots(const EvalReport& report, const std::string& dir) {
                                               ar)},
       {"pixel_roc.png",
        RenderLineChart({"Pixel ROC", "false positive rate", "true positive rate", 0, 0.05, 0, 1},
-                       roc)}};
+                       roc)},
+      {"pixel_pr.png",
+       RenderLineChart({"Pixel precision-recall (8-bit map)", "recall", "precision", 0, 1, 0, 1},
+                       pr)}};
   for (const auto& [name, img] : charts) {
     const std::string path = (std::filesystem::path(dir) / name).string();
     if (!cv::imwrite(path, img)) return Status::Internal("cannot write " + path);

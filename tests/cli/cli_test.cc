@@ -122,6 +122,15 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
     for (const char* f : {"0.005", "0.010", "0.015", "0.020", "0.025", "0.030"})
       EXPECT_TRUE(j["regression"][v]["tpr_at_fpr"].contains(f)) << v << " " << f;
     EXPECT_TRUE(j["regression"][v]["ar"].contains("1000"));
+    // The anomaly-segmentation metrics of the served map: the fixture's test frames hold both
+    // obstacle and free-space pixels, so both metrics are defined numbers, not null.
+    for (const char* metric : {"ap", "fpr_at_tpr95"}) {
+      ASSERT_TRUE(j["regression"][v].contains(metric)) << v << " " << metric;
+      ASSERT_TRUE(j["regression"][v][metric].is_number()) << v << " " << metric;
+      const double value = j["regression"][v][metric].get<double>();
+      EXPECT_GE(value, 0.0) << v << " " << metric;
+      EXPECT_LE(value, 1.0) << v << " " << metric;
+    }
   }
   EXPECT_GT(j["timing_ms"]["total"].get<double>(), 0.0);
   // Floors a broken stage would miss (the fixture model scores about 0.33 TPR at FPR 0.03,
@@ -130,9 +139,11 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
   EXPECT_GE(j["regression"]["BP+Fusion@4"]["tpr_at_fpr"]["0.030"].get<double>(), 0.15);
   EXPECT_GE(j["regression"]["BP+Fusion@4"]["ar"]["1000"].get<double>(), 0.06);
   EXPECT_GE(j["proposals"]["OAOCC+OLP@4+MS"]["ar"]["1000"].get<double>(), 0.05);
-  for (const char* png :
-       {"recall_vs_proposals.png", "recall_vs_iou.png", "ar_vs_proposals.png", "pixel_roc.png"})
+  for (const char* png : {"recall_vs_proposals.png", "recall_vs_iou.png", "ar_vs_proposals.png",
+                          "pixel_roc.png", "pixel_pr.png"})
     EXPECT_FALSE(cv::imread((out_ / "plots" / png).string()).empty()) << png;
+  // The printed table carries them too.
+  EXPECT_NE(run.output.find("Pixel AP and FPR at 95 % TPR"), std::string::npos) << run.output;
 }
 
 TEST_F(CliTest, BrokenModelIsRefusedWithTheFileNamed) {
