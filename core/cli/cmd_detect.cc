@@ -1,29 +1,25 @@
 // tod detect --model MODEL_DIR IMAGE... --out DIR: per image STEM, STEM.json, STEM_prob.png
-// (probability map, 255 = 1.0) and STEM_overlay.png.
+// (probability map, 255 = 1.0) and STEM_overlay.png; with --stages also the pictures and counts
+// of the intermediate stages (core/pipeline/stage_images.h).
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
 #include "core/pipeline/detection_output.h"
+#include "core/pipeline/model_bundle.h"
+#include "core/pipeline/stage_images.h"
 
 namespace tod::cli {
-namespace {
-
-Status WritePng(const std::string& path, const cv::Mat& image) {
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", image, bytes)) return Status::Internal("cannot encode " + path);
-  return WriteFileAtomically(path, std::string(bytes.begin(), bytes.end()));
-}
-
-}  // namespace
 
 Runner AddDetectCommand(CLI::App& app) {
   struct Args {
     std::string model, out;
     std::vector<std::string> images;
     DetectOptions options;
+    bool stages = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("detect", "find obstacles in images");
@@ -34,9 +30,20 @@ Runner AddDetectCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--max-proposals", args->options.max_proposals, "proposals listed in the JSON")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag(
+      "--stages", args->stages,
+      "also write each stage as PNG (STEM_stage_*.png) and its counts (STEM_stages.json)");
   return [args] {
     auto detector = Detector::Load(args->model);
     if (!detector.ok()) return Fail(detector.status().message());
+    // The Detector interface hides its bundle, so the stage pictures get their own copy of the
+    // same bundle (loaded only with --stages).
+    std::optional<ModelBundle> stage_bundle;
+    if (args->stages) {
+      auto bundle = LoadModelBundle(args->model);
+      if (!bundle.ok()) return Fail(bundle.status().message());
+      stage_bundle = std::move(*bundle);
+    }
     std::error_code ec;
     std::filesystem::create_directories(args->out, ec);
     if (ec) return Fail("cannot create " + args->out + ": " + ec.message());
@@ -59,14 +66,22 @@ Runner AddDetectCommand(CLI::App& app) {
       Status st = WriteFileAtomically(base.string() + ".json",
                                       DetectionToJson(*detection, path).dump(2) + "\n");
       if (st.ok())
-        st = WritePng(base.string() + "_prob.png", ProbabilityTo8Bit(detection->probability));
-      if (st.ok()) st = WritePng(base.string() + "_overlay.png", DrawOverlay(image, *detection));
+        st = WritePngAtomically(base.string() + "_prob.png",
+                                ProbabilityTo8Bit(detection->probability));
+      if (st.ok())
+        st = WritePngAtomically(base.string() + "_overlay.png", DrawOverlay(image, *detection));
+      if (st.ok() && stage_bundle) {
+        auto stages = RenderStageImages(*stage_bundle, image);
+        if (stages.ok()) stages->counts["image"] = path;
+        st = stages.ok() ? WriteStageImages(*stages, base.string()) : stages.status();
+      }
       if (!st.ok()) return Fail(st.message());
       double total = 0;
       for (const auto& [stage, ms] : detection->timings) total += ms;
       std::cout << path << ": " << detection->obstacles.size() << " obstacles, "
                 << detection->proposals.size() << " proposals listed, " << static_cast<int>(total)
-                << " ms -> " << base.string() << "{.json,_prob.png,_overlay.png}\n";
+                << " ms -> " << base.string() << "{.json,_prob.png,_overlay.png"
+                << (stage_bundle ? ",_stage_*.png,_stages.json" : "") << "}\n";
     }
     return failures == 0 ? 0 : 1;
   };

@@ -1,7 +1,12 @@
 #include "core/pipeline/detection_output.h"
 
 #include <cstdio>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "core/base/atomic_file.h"
 
 namespace tod {
 
@@ -69,6 +74,12 @@ cv::Mat3b DrawOverlay(const cv::Mat3b& bgr, const Detection& d, int top_proposal
                 0.5 * scale + 0.2, {0, 255, 255}, 1, cv::LINE_AA);
   }
   return out;
+}
+
+Status WritePngAtomically(const std::string& path, const cv::Mat& image) {
+  std::vector<uchar> bytes;
+  if (!cv::imencode(".png", image, bytes)) return Status::Internal("cannot encode " + path);
+  return WriteFileAtomically(path, std::string(bytes.begin(), bytes.end()));
 }
 
 }  // namespace tod

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "core/base/status.h"
 #include "core/pipeline/detector.h"
 
 namespace tod {
@@ -21,5 +22,9 @@ cv::Mat1b ProbabilityTo8Bit(const cv::Mat1f& probability);
 // The frame with the probability map as a red heat overlay, obstacle boxes in yellow with their
 // peak probability, and the top proposals as thin cyan boxes.
 cv::Mat3b DrawOverlay(const cv::Mat3b& bgr, const Detection& detection, int top_proposals = 10);
+
+// Encodes `image` as PNG and writes it atomically (temporary file + rename), so a reader never
+// sees half a picture.
+Status WritePngAtomically(const std::string& path, const cv::Mat& image);
 
 }  // namespace tod

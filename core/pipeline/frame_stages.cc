@@ -53,7 +53,8 @@ cv::Mat1f RegionEdgeMap(const OcclusionEdges& oaocc, const MultilayerRegions& re
 std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
                                           const MultilayerRegions& regions,
                                           const EdgeBoxParams& box_params, int k, bool multistride,
-                                          const SizeFilter* size_filter) {
+                                          const SizeFilter* size_filter, EdgeBoxStats* stats) {
+  if (stats != nullptr) *stats = EdgeBoxStats{};
   const cv::Mat1f map = RegionEdgeMap(oaocc, regions, k);
   if (map.empty()) return {};
   EdgeBoxParams params = box_params;
@@ -70,7 +71,7 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
   std::optional<WindowAdmission> admission;
   if (filtered) admission.emplace(*size_filter, region.y);
   for (ScoredBox b :
-       ScoreEdgeBoxes(NormaliseToMax(map), params, nullptr, admission ? &*admission : nullptr)) {
+       ScoreEdgeBoxes(NormaliseToMax(map), params, stats, admission ? &*admission : nullptr)) {
     b.box.x += region.x;
     b.box.y += region.y;
     if (filtered && !size_filter->Keep(b.box)) continue;

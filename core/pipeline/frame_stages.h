@@ -48,11 +48,13 @@ struct ProposalSet {
 };
 
 // Boxes of region k (0-based) in full-image coordinates, objectness descending, through the size
-// filter when one is given.
+// filter when one is given. `stats` (may be null) receives the scorer's counters for the region
+// (boxes_out counts the boxes before the size filter's final pass).
 std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
                                           const MultilayerRegions& regions,
                                           const EdgeBoxParams& box_params, int k, bool multistride,
-                                          const SizeFilter* size_filter);
+                                          const SizeFilter* size_filter,
+                                          EdgeBoxStats* stats = nullptr);
 // The union of per-region boxes (index = region), ranked by objectness; no cross-region NMS.
 ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region);
 

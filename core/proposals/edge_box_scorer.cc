@@ -67,6 +67,8 @@ std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxPa
   if (!Usable(edge_map) || !ValidateEdgeBoxParams(params).ok()) return {};
 
   const BoxScorer scorer(edge_map, params);
+  s.edge_pixels = static_cast<long long>(scorer.groups().edges.row_col.size());
+  s.edge_groups = scorer.groups().count();
   std::vector<ScoredBox> kept = ScanWindowGrid(scorer, params, s, admission);
   s.boxes_out = static_cast<long long>(kept.size());
   return kept;

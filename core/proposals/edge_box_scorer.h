@@ -49,6 +49,8 @@ Status ValidateEdgeBoxParams(const EdgeBoxParams& params);
 
 // Work counters of one ScoreEdgeBoxes call (for benchmarks and logs).
 struct EdgeBoxStats {
+  long long edge_pixels = 0;              // map pixels > edge_min_mag (what the groups are made of)
+  long long edge_groups = 0;              // edge groups after dissolving the weak ones
   long long windows_visited = 0;          // grid windows scored (only admitted ones, with one)
   long long windows_past_early_exit = 0;  // grid windows that reached the boundary-affinity walk
   long long windows_nonzero = 0;          // grid windows with a final score > 0

@@ -98,6 +98,51 @@ TEST_F(CliTest, DetectWritesJsonMapAndOverlay) {
   EXPECT_EQ(peak, 255.0);  // the map is normalised by its maximum
   const cv::Mat overlay = cv::imread((out_ / (stem + "_overlay.png")).string());
   EXPECT_EQ(overlay.size(), cv::Size(640, 320));
+  // The stage pictures are written only on request (--stages).
+  for (const auto& e : fs::directory_iterator(out_))
+    EXPECT_EQ(e.path().filename().string().find("_stage"), std::string::npos) << e.path();
+}
+
+TEST_F(CliTest, DetectStagesWritesEveryStageAsAFrameSizedPngAndTheCounts) {
+  const std::string image = FirstTestImage();
+  ASSERT_FALSE(image.empty());
+  const CommandResult run =
+      Shell(tod_ + " detect --stages --model " + model_ + " --out " + out_.string() + " " + image);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("_stages.json"), std::string::npos) << run.output;
+  const std::string stem = fs::path(image).stem().string();
+  EXPECT_TRUE(fs::exists(out_ / (stem + ".json")));  // what detect writes anyway
+  EXPECT_TRUE(fs::exists(out_ / (stem + "_overlay.png")));
+  for (const std::string name :
+       {"base_edges", "enhanced_edges", "superpixels", "occlusion", "regions", "proposals_R1",
+        "proposals_R2", "proposals_R3", "proposals_R4"}) {
+    const fs::path png = out_ / (stem + "_stage_" + name + ".png");
+    const cv::Mat picture = cv::imread(png.string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(picture.empty()) << png;
+    EXPECT_EQ(picture.size(), cv::Size(640, 320)) << png;
+    const bool grey = name == "base_edges" || name == "enhanced_edges";
+    EXPECT_EQ(picture.type(), grey ? CV_8UC1 : CV_8UC3) << png;
+  }
+  std::ifstream in(out_ / (stem + "_stages.json"));
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["image"], image);
+  EXPECT_EQ(j["width"], 640);
+  EXPECT_EQ(j["height"], 320);
+  EXPECT_EQ(j["layers"], 4);
+  EXPECT_GT(j["base_edge_pixels"].get<long long>(), 0);
+  EXPECT_GT(j["superpixels"].get<int>(), 0);
+  EXPECT_GT(j["occlusion_edge_pixels"].get<long long>(), 0);
+  ASSERT_EQ(j["regions"].size(), 4u);
+  long long kept = 0;
+  for (const auto& region : j["regions"]) {
+    for (const char* key :
+         {"name", "x", "y", "w", "h", "edge_pixels", "edge_groups", "windows_scored",
+          "boxes_after_nms", "proposals_kept", "proposals_drawn"})
+      EXPECT_TRUE(region.contains(key)) << key;
+    kept += region["proposals_kept"].get<long long>();
+  }
+  EXPECT_GT(kept, 0);
+  EXPECT_EQ(j["proposals_total"].get<long long>(), kept);
 }
 
 TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {

@@ -6,6 +6,7 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
+#include "core/proposals/edge_groups.h"
 #include "tests/proposals/test_maps.h"
 
 namespace tod {
@@ -99,6 +100,22 @@ TEST(ScoreEdgeBoxesTest, OutputIsSortedInsideTheMapAndReproducible) {
   const auto again = ScoreEdgeBoxes(map, params);
   ASSERT_EQ(again.size(), boxes.size());
   for (size_t i = 0; i < boxes.size(); ++i) EXPECT_EQ(again[i].box, boxes[i].box);
+}
+
+TEST(ScoreEdgeBoxesTest, StatsCountTheEdgePixelsAndGroupsOfTheMap) {
+  // Two square outlines of 36 pixels each, plus faint pixels at edge_min_mag that are no edge.
+  cv::Mat1f map(60, 80, 0.f);
+  DrawRectangleContour(map, 10, 10, 19, 19);
+  DrawRectangleContour(map, 40, 30, 49, 39);
+  const EdgeBoxParams params;
+  for (int x = 55; x < 75; ++x) map(50, x) = params.edge_min_mag;
+  EdgeBoxStats stats;
+  ScoreEdgeBoxes(map, params, &stats);
+  EXPECT_EQ(stats.edge_pixels, 72);
+  const EdgeGroups groups = BuildEdgeGroups(
+      map, {params.edge_min_mag, params.edge_merge_thr, params.cluster_min_mag, params.gamma});
+  EXPECT_GE(groups.count(), 2);
+  EXPECT_EQ(stats.edge_groups, groups.count());
 }
 
 TEST(ScoreEdgeBoxesTest, RefinementNeverLowersAScore) {
