@@ -94,8 +94,9 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
                                                        &bundle.occlusion, bundle.params.superpixels,
                                                        /*enhance=*/false);
     const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1, kMaxProposals);
-    const ProposalSet olp1 = ProposeBoxes(plain, geo.regions, bundle.params.boxes,
-                                          {1, false, bundle.params.size_filter}, geo.size_filter);
+    const ProposalSet olp1 = ProposeBoxes(
+        plain, geo.regions, bundle.params.boxes,
+        {1, false, bundle.params.size_filter, bundle.params.region_merge_iou}, geo.size_filter);
 
     // The detector's own path (timed): enhanced edges, BP = OAOCC+OLP@4+MS, regression, map.
     StageTimer timer;
@@ -107,7 +108,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     for (int k = 0; k < layers; ++k)
       ms_regions.push_back(
           ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k, true, filter));
-    ProposalSet bp = MergeRegionBoxes(ms_regions);
+    ProposalSet bp = MergeRegionBoxes(ms_regions, bundle.params.region_merge_iou);
     timer.Mark("proposals");
     // R1's stride factor is 1 with and without MS, so its boxes serve OAOCC+OLP@1 and OP too;
     // only R2..RK are scored again without MS.
@@ -129,7 +130,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
         AccumulateProbabilityMap(bp_fusion, s.image.size(), bundle.params.probability_map);
     timer.Mark("probability_map");
 
-    ProposalSet op = MergeRegionBoxes(plain_regions);
+    ProposalSet op = MergeRegionBoxes(plain_regions, bundle.params.region_merge_iou);
     const std::vector<Box> op_boxes = BoxesOf(op.boxes);
     const RegressedProposals op_reg =
         RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(op));

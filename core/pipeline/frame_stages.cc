@@ -6,6 +6,8 @@
 
 #include "core/features/box_features.h"
 #include "core/features/colour_integrals.h"
+#include "core/pipeline/pipeline_params.h"
+#include "core/proposals/greedy_nms.h"
 
 namespace tod {
 
@@ -80,21 +82,39 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
   return out;
 }
 
-ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region) {
+ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region,
+                             float merge_iou) {
   std::vector<std::pair<ScoredBox, int>> merged;
+  int min_x = 0, min_y = 0, max_x = 0, max_y = 0;
   for (std::size_t k = 0; k < per_region.size(); ++k)
-    for (const ScoredBox& b : per_region[k]) merged.emplace_back(b, static_cast<int>(k));
-  // No cross-region NMS (authors' code): the union, ranked by objectness.
+    for (const ScoredBox& b : per_region[k]) {
+      if (merged.empty()) min_x = max_x = b.box.x, min_y = max_y = b.box.y;
+      min_x = std::min(min_x, b.box.x), max_x = std::max(max_x, b.box.x);
+      min_y = std::min(min_y, b.box.y), max_y = std::max(max_y, b.box.y);
+      merged.emplace_back(b, static_cast<int>(k));
+    }
   std::stable_sort(merged.begin(), merged.end(),
                    [](const auto& a, const auto& b) { return a.first.score > b.first.score; });
   ProposalSet out;
   out.boxes.reserve(merged.size());
   out.layer.reserve(merged.size());
+  const bool suppress = merge_iou < 1.f;
+  GreedyNms nms(merge_iou, static_cast<int>(merged.size()), min_x, min_y, max_x, max_y);
   for (const auto& [box, k] : merged) {
+    if (suppress && !nms.Offer(box)) continue;
     out.boxes.push_back(box);
     out.layer.push_back(k);
   }
   return out;
+}
+
+ProposalOptions DetectorProposalOptions(const PipelineParams& params, int layers) {
+  ProposalOptions options;
+  options.layers_used = layers;
+  options.multistride = params.multistride;
+  options.size_filter = params.size_filter;
+  options.merge_iou = params.region_merge_iou;
+  return options;
 }
 
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
@@ -105,7 +125,7 @@ ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& r
   for (int k = 0; k < used; ++k)
     per_region.push_back(ProposeRegionBoxes(oaocc, regions, box_params, k, options.multistride,
                                             options.size_filter ? &size_filter : nullptr));
-  return MergeRegionBoxes(per_region);
+  return MergeRegionBoxes(per_region, options.merge_iou);
 }
 
 cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,

@@ -40,7 +40,13 @@ struct ProposalOptions {
   int layers_used = 4;  // @k: boxes from R_1 .. R_k
   bool multistride = true;
   bool size_filter = true;
+  float merge_iou = 0.75f;  // PipelineParams::region_merge_iou
 };
+
+// The detector's proposal options for a bundle's parameters: all `layers`, its multistride, size
+// filter and cross-region merge settings.
+struct PipelineParams;
+ProposalOptions DetectorProposalOptions(const PipelineParams& params, int layers);
 
 struct ProposalSet {
   std::vector<ScoredBox> boxes;  // full-image coordinates, objectness descending
@@ -55,8 +61,10 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
                                           const EdgeBoxParams& box_params, int k, bool multistride,
                                           const SizeFilter* size_filter,
                                           EdgeBoxStats* stats = nullptr);
-// The union of per-region boxes (index = region), ranked by objectness; no cross-region NMS.
-ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region);
+// The union of per-region boxes (index = region), ranked by objectness, through a greedy NMS at
+// merge_iou across regions (1 = the plain union, as the authors' code); ties keep region order.
+ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region,
+                             float merge_iou);
 
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                          const EdgeBoxParams& box_params, const ProposalOptions& options,

@@ -85,7 +85,7 @@ FrameResult AnalyseFrame(const ModelBundle& bundle, const Sample& s,
                                               bundle.params.multistride, filter)
                          : all;
   }
-  ProposalSet merged = MergeRegionBoxes(filtered);
+  ProposalSet merged = MergeRegionBoxes(filtered, bundle.params.region_merge_iou);
   std::vector<Box> by_objectness;
   for (const ScoredBox& b : merged.boxes) by_objectness.push_back(b.box);
   const RegressedProposals reg =

@@ -68,10 +68,8 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   const OcclusionEdges oaocc = ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges,
                                                      &bundle_.occlusion, bundle_.params.superpixels,
                                                      /*enhance=*/true, &timer);
-  ProposalOptions proposal_options;
-  proposal_options.layers_used = geometry.regions.num_layers();
-  proposal_options.multistride = bundle_.params.multistride;
-  proposal_options.size_filter = bundle_.params.size_filter;
+  const ProposalOptions proposal_options =
+      DetectorProposalOptions(bundle_.params, geometry.regions.num_layers());
   ProposalSet proposals = ProposeBoxes(oaocc, geometry.regions, bundle_.params.boxes,
                                        proposal_options, geometry.size_filter);
   timer.Mark("proposals");

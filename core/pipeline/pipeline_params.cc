@@ -22,7 +22,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score,
                                                 top_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradient_edges,
                                                 superpixels, boxes, multistride, size_filter,
-                                                fusion, probability_map)
+                                                region_merge_iou, fusion, probability_map)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
 
@@ -37,10 +37,10 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
   if (!boxes.ok()) return Status::InvalidArgument("parameters: " + boxes.message());
   if (p.regions.num_layers < 1 || p.superpixels.k < 1 || p.fusion.keep_ratio < 0 ||
       p.fusion.keep_ratio > 1 || p.probability_map.top_fraction < 0 ||
-      p.probability_map.top_fraction > 1)
+      p.probability_map.top_fraction > 1 || !(p.region_merge_iou > 0 && p.region_merge_iou <= 1))
     return Status::InvalidArgument(
         "parameters out of range (regions.num_layers, superpixels.k, fusion.keep_ratio, "
-        "probability_map.top_fraction)");
+        "probability_map.top_fraction, region_merge_iou in (0, 1])");
   return p;
 }
 

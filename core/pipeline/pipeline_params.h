@@ -29,6 +29,11 @@ struct PipelineParams {
   }();
   bool multistride = true;  // MS: stride factor (K - k + 1) / K in region k (§4.2.6)
   bool size_filter = true;  // §4.3, switchable
+  // NMS IoU across regions when their boxes are merged into one ranking (ours; the authors' code
+  // merges without it, = 1). R2..RK are crops of the same occlusion map as R1, so without it the
+  // inner regions add near-copies of R1's best boxes, which take the top ranks from distinct
+  // boxes: on real frames more layers then *lowered* recall (README, "Real frames").
+  float region_merge_iou = 0.75f;
   FusionParams fusion;
   ProbabilityMapParams probability_map;
 };

@@ -167,10 +167,8 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
       const OcclusionEdges oaocc =
           ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges, &bundle.occlusion,
                                 bundle.params.superpixels, true);
-      ProposalOptions popts;
-      popts.layers_used = bundle.regions.num_layers();
-      popts.multistride = bundle.params.multistride;
-      popts.size_filter = bundle.params.size_filter;
+      const ProposalOptions popts =
+          DetectorProposalOptions(bundle.params, bundle.regions.num_layers());
       const ProposalSet all =
           ProposeBoxes(oaocc, bundle.regions, bundle.params.boxes, popts, bundle.size_filter);
       proposal_counts[i] = static_cast<long long>(all.boxes.size());
