@@ -45,6 +45,10 @@ Runner AddTrainCommand(CLI::App& app) {
       ->check(CLI::Range(1, 2000));
   cmd->add_option("--threads", args->train.threads, "worker threads (0 = all cores)");
   cmd->add_flag("--no-size-filter", args->no_size_filter, "switch the box size filter off");
+  bool* correct = &args->train.prior_correction;
+  cmd->add_flag_callback(
+      "--no-prior-correction", [correct] { *correct = false; },
+      "keep the classifiers' balanced-sample prior (as bundles before the correction)");
   cmd->add_option("--refine-limit", args->train.params.boxes.refine_limit,
                   "refine at most the N best grid local maxima per region (0 = all of them)")
       ->check(CLI::NonNegativeNumber);

@@ -68,11 +68,15 @@ class PixelEdgeClassifier : public EdgeSource {
   bool trained() const { return !forest_.empty(); }
   cv::Mat1f Compute(const cv::Mat3b& bgr) const override;
   std::string kind() const override { return "pixel_forest"; }
+  // Of the last TryTrain: (share of negative cells sampled) / (share of boundary cells sampled),
+  // the odds factor that undoes the balanced sampling (PriorCorrection). Not stored in the file.
+  double sampled_odds_scale() const { return sampled_odds_scale_; }
   Status Save(std::ostream& out) const;
   static Result<PixelEdgeClassifier> Load(std::istream& in, const std::string& what);
 
  private:
   RandomForest forest_;
+  double sampled_odds_scale_ = 1.0;
   EdgeChannelParams channel_params_;
 };
 

@@ -84,6 +84,7 @@ Result<PixelEdgeClassifier> PixelEdgeClassifier::TryTrain(
   cv::Mat1f features(0, num_features);
   std::vector<float> targets;
   std::size_t positives = 0;
+  double positive_cells_available = 0, negative_cells_available = 0;
   for (std::size_t f = 0; f < frames.size(); ++f) {
     const EdgeTrainingFrame& frame = frames[f];
     const CellLabels cells = ComputeCellLabels(frame.labels, params.boundary_radius);
@@ -100,6 +101,8 @@ Result<PixelEdgeClassifier> PixelEdgeClassifier::TryTrain(
     // Same number of each class from every frame, so the forest's mean is a balanced probability.
     const std::size_t count = std::min({per_class, positive_cells.size(), negative_cells.size()});
     if (count == 0) continue;
+    positive_cells_available += static_cast<double>(positive_cells.size());
+    negative_cells_available += static_cast<double>(negative_cells.size());
     std::mt19937_64 rng(params.forest.seed * 0x9E3779B97F4A7C15ULL + f);
     const EdgeChannels channels = ComputeEdgeChannels(frame.image, params.channels);
     const PixelFeatureExtractor extractor(channels);
@@ -123,6 +126,9 @@ Result<PixelEdgeClassifier> PixelEdgeClassifier::TryTrain(
   PixelEdgeClassifier classifier;
   classifier.forest_ = RandomForest::Train(features, targets, params.forest);
   classifier.channel_params_ = params.channels;
+  // Equal counts per class from every frame: negatives were kept at count / negatives available,
+  // positives at count / positives available, so the odds factor is the ratio of availabilities.
+  classifier.sampled_odds_scale_ = positive_cells_available / negative_cells_available;
   if (classifier.forest_.empty()) {
     return Status::Internal("pixel edge training: the forest trainer returned no trees");
   }

@@ -187,6 +187,8 @@ Result<OcclusionClassifier> OcclusionClassifier::Fit(
     negative_order.resize(keep_negative);
     std::sort(negative_order.begin(), negative_order.end());
   }
+  const double negative_share_kept =
+      num_negative > 0 ? static_cast<double>(negative_order.size()) / num_negative : 1.0;
   num_negative = negative_order.size();
   cv::Mat1f features(static_cast<int>(num_positive + num_negative), kNumOcclusionFeatures);
   std::vector<float> targets;
@@ -208,6 +210,7 @@ Result<OcclusionClassifier> OcclusionClassifier::Fit(
   OcclusionClassifier classifier;
   classifier.params_ = params;
   classifier.forest_ = std::move(forest).value();
+  classifier.sampled_odds_scale_ = negative_share_kept;  // every positive pair is kept
   return classifier;
 }
 

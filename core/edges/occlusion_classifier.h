@@ -41,6 +41,10 @@ class OcclusionClassifier {
                                          const OcclusionParams& params);
   bool trained() const { return !forest_.empty(); }
   const OcclusionParams& params() const { return params_; }
+  // Of the last Fit: (share of negative pairs kept) / (share of positive pairs kept), the odds
+  // factor that undoes the class balancing (PriorCorrection); 1 when nothing was dropped. Not
+  // stored in the file: the bundle's manifest keeps it.
+  double sampled_odds_scale() const { return sampled_odds_scale_; }
 
   // Occlusion edge map on the crop: boundary pixels carry the max pair probability (>= floor),
   // all other pixels 0. Returns an empty map when the inputs disagree in size.
@@ -55,6 +59,7 @@ class OcclusionClassifier {
 
  private:
   OcclusionParams params_;
+  double sampled_odds_scale_ = 1.0;
   RandomForest forest_;
 };
 

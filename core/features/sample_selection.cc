@@ -199,6 +199,17 @@ Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& prop
     targets.reserve(indices.size());
     for (const int i : indices) targets.push_back(target_of(i));
   };
+  if (gt.free_space == FreeSpace::kNotObstacle) {
+    // No road label (obstacle-mask benchmarks): road and background cannot be told apart, so
+    // every non-obstacle proposal is category (i) and OBDR draws its negatives, independently of
+    // ORDR's, from the same pool. The two regressors then differ by their samples only, and the
+    // fusion acts as a two-member ensemble instead of adding a background expert.
+    assemble(select_negatives(ProposalCategory::kRoad, params.ordr_negatives), out.ordr_indices,
+             out.ordr_targets);
+    assemble(select_negatives(ProposalCategory::kRoad, params.obdr_negatives), out.obdr_indices,
+             out.obdr_targets);
+    return out;
+  }
   assemble(select_negatives(ProposalCategory::kRoad, params.ordr_negatives), out.ordr_indices,
            out.ordr_targets);
   assemble(select_negatives(ProposalCategory::kBackground, params.obdr_negatives), out.obdr_indices,

@@ -90,9 +90,9 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const int layers = geo.regions.num_layers();
 
     // Proposal-only variants on the plain (not obstacle-aware) occlusion edges.
-    const OcclusionEdges plain = ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges,
-                                                       &bundle.occlusion, bundle.params.superpixels,
-                                                       /*enhance=*/false);
+    const OcclusionEdges plain =
+        ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion, bundle.params,
+                              /*enhance=*/false);
     const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1, kMaxProposals);
     const ProposalSet olp1 = ProposeBoxes(
         plain, geo.regions, bundle.params.boxes,
@@ -100,9 +100,9 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
 
     // The detector's own path (timed): enhanced edges, BP = OAOCC+OLP@4+MS, regression, map.
     StageTimer timer;
-    const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges,
-                                                       &bundle.occlusion, bundle.params.superpixels,
-                                                       /*enhance=*/true, &timer);
+    const OcclusionEdges oaocc =
+        ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion, bundle.params,
+                              /*enhance=*/true, &timer);
     const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
     std::vector<std::vector<ScoredBox>> ms_regions;
     for (int k = 0; k < layers; ++k)

@@ -13,7 +13,7 @@ namespace tod {
 
 OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerRegions& regions,
                                      const EdgeSource& edges, const OcclusionClassifier* classifier,
-                                     const StickySuperpixelParams& superpixel_params, bool enhance,
+                                     const PipelineParams& params, bool enhance,
                                      StageTimer* timer) {
   auto mark = [timer](const char* stage) {
     if (timer != nullptr) timer->Mark(stage);
@@ -22,6 +22,7 @@ OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerReg
   out.r1 = ClipToImage(regions.layers.front(), image.cols, image.rows);
   out.crop = image(out.r1.rect());
   out.base_edge = edges.Compute(out.crop);
+  CorrectSampledPrior(out.base_edge, params.prior_correction.edge_odds);
   // §2.2 single pass: Ê(p) = n(p) E(p), n(p) = number of layers containing p. Each inner layer
   // adds the same map once more over its rectangle.
   out.enhanced = out.base_edge.clone();
@@ -34,10 +35,11 @@ OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerReg
     }
   }
   mark("edges");
-  out.superpixels = ComputeStickySuperpixels(out.crop, out.enhanced, superpixel_params);
+  out.superpixels = ComputeStickySuperpixels(out.crop, out.enhanced, params.superpixels);
   mark("superpixels");
   if (classifier != nullptr) {
     out.occlusion = classifier->Paint(out.crop, out.enhanced, out.superpixels);
+    CorrectSampledPrior(out.occlusion, params.prior_correction.occlusion_odds);
     mark("occlusion");
   }
   return out;

@@ -10,6 +10,7 @@
 #include "core/edges/occlusion_classifier.h"
 #include "core/edges/sticky_superpixels.h"
 #include "core/pipeline/multilayer_regions.h"
+#include "core/pipeline/pipeline_params.h"
 #include "core/proposals/edge_box_scorer.h"
 #include "core/proposals/size_filter.h"
 #include "core/proposals/window_admission.h"
@@ -29,7 +30,7 @@ struct OcclusionEdges {
 // With a null classifier only E, Ê and the superpixels are computed (training of the classifier).
 OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerRegions& regions,
                                      const EdgeSource& edges, const OcclusionClassifier* classifier,
-                                     const StickySuperpixelParams& superpixel_params, bool enhance,
+                                     const PipelineParams& params, bool enhance,
                                      StageTimer* timer = nullptr);
 
 // Region k's occlusion edge map (un-normalised): the R1 map cropped to R_k, with the artificial
@@ -45,7 +46,6 @@ struct ProposalOptions {
 
 // The detector's proposal options for a bundle's parameters: all `layers`, its multistride, size
 // filter and cross-region merge settings.
-struct PipelineParams;
 ProposalOptions DetectorProposalOptions(const PipelineParams& params, int layers);
 
 struct ProposalSet {

@@ -70,9 +70,8 @@ FrameResult AnalyseFrame(const ModelBundle& bundle, const Sample& s,
                          const LossAnalysisOptions& options) {
   FrameResult out;
   const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
-  const OcclusionEdges oaocc =
-      ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion,
-                            bundle.params.superpixels, /*enhance=*/true);
+  const OcclusionEdges oaocc = ComputeOcclusionEdges(
+      s.image, geo.regions, *bundle.edges, &bundle.occlusion, bundle.params, /*enhance=*/true);
   const int layers = geo.regions.num_layers();
   std::vector<ScoredBox> unfiltered;
   std::vector<std::vector<ScoredBox>> filtered(layers);

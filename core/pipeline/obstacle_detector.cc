@@ -6,23 +6,6 @@
 
 namespace tod {
 
-FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height) {
-  FrameGeometry g;
-  g.regions = bundle.regions.ScaledTo(width, height);
-  g.size_filter = bundle.size_filter;
-  const double sx = static_cast<double>(width) / std::max(1, bundle.regions.image_width);
-  const double sy = static_cast<double>(height) / std::max(1, bundle.regions.image_height);
-  if (sx != 1.0 || sy != 1.0) {
-    for (SizeBand& b : g.size_filter.bands) {
-      b.center_y_min *= sy, b.center_y_max *= sy;
-      b.h_min *= sy, b.h_max *= sy;
-      b.w_min *= sx, b.w_max *= sx;
-      b.area_min *= sx * sy, b.area_max *= sx * sy;
-    }
-  }
-  return g;
-}
-
 RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& image,
                                     const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                                     ProposalSet proposals, StageTimer* timer) {
@@ -66,7 +49,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   StageTimer timer;
   const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
   const OcclusionEdges oaocc = ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges,
-                                                     &bundle_.occlusion, bundle_.params.superpixels,
+                                                     &bundle_.occlusion, bundle_.params,
                                                      /*enhance=*/true, &timer);
   const ProposalOptions proposal_options =
       DetectorProposalOptions(bundle_.params, geometry.regions.num_layers());

@@ -4,18 +4,11 @@
 #include <memory>
 
 #include "core/pipeline/detector.h"
+#include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/model_bundle.h"
 
 namespace tod {
-
-// Regions and size filter of a bundle for frames of a given size (scaled proportionally when the
-// frame size differs from the training size).
-struct FrameGeometry {
-  MultilayerRegions regions;
-  SizeFilter size_filter;
-};
-FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height);
 
 // ORDR and OBDR scores of every proposal (features computed here).
 struct RegressedProposals {

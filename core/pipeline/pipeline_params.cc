@@ -20,11 +20,21 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeBoxParams, alpha, beta, min_
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FusionParams, beta1, keep_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score, nms_iou, max_boxes,
                                                 top_fraction)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PriorCorrection, edge_odds, occlusion_odds)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradient_edges,
                                                 superpixels, boxes, multistride, size_filter,
-                                                region_merge_iou, fusion, probability_map)
+                                                region_merge_iou, prior_correction, fusion,
+                                                probability_map)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
+
+void CorrectSampledPrior(cv::Mat1f& probability, double odds_scale) {
+  if (odds_scale == 1.0) return;
+  const float c = static_cast<float>(odds_scale);
+  probability.forEach([c](float& p, const int*) {
+    if (p > 0.f && p < 1.f) p = p * c / (p * c + (1.f - p));
+  });
+}
 
 Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
   PipelineParams p;
@@ -37,10 +47,11 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
   if (!boxes.ok()) return Status::InvalidArgument("parameters: " + boxes.message());
   if (p.regions.num_layers < 1 || p.superpixels.k < 1 || p.fusion.keep_ratio < 0 ||
       p.fusion.keep_ratio > 1 || p.probability_map.top_fraction < 0 ||
-      p.probability_map.top_fraction > 1 || !(p.region_merge_iou > 0 && p.region_merge_iou <= 1))
+      p.probability_map.top_fraction > 1 || !(p.region_merge_iou > 0 && p.region_merge_iou <= 1) ||
+      !(p.prior_correction.edge_odds > 0) || !(p.prior_correction.occlusion_odds > 0))
     return Status::InvalidArgument(
         "parameters out of range (regions.num_layers, superpixels.k, fusion.keep_ratio, "
-        "probability_map.top_fraction, region_merge_iou in (0, 1])");
+        "probability_map.top_fraction, region_merge_iou in (0, 1], prior_correction > 0)");
   return p;
 }
 

@@ -14,6 +14,21 @@
 
 namespace tod {
 
+// The edge and occlusion classifiers are trained on class-balanced samples (every obstacle
+// contour, a few negatives per positive), so their raw outputs carry the balanced prior: on a
+// real frame, where obstacle contours are a tiny share of all boundaries, nearly every texture
+// boundary scores above Edge Boxes' 0.1 (README, "Real frames"). The standard correction for
+// class-dependent sampling maps p to p·c / (p·c + 1 - p) with c = (rate at which negatives were
+// kept) / (rate at which positives were kept), measured by `tod train`; 1 = uncorrected (bundles
+// made before the correction).
+struct PriorCorrection {
+  double edge_odds = 1.0;       // c of the pixel edge classifier
+  double occlusion_odds = 1.0;  // c of the occlusion classifier
+};
+
+// p -> p·c / (p·c + 1 - p) on every pixel in place (0 stays 0, 1 stays 1; c = 1: unchanged).
+void CorrectSampledPrior(cv::Mat1f& probability, double odds_scale);
+
 struct PipelineParams {
   RegionParams regions;
   GradientEdgeParams gradient_edges;
@@ -34,6 +49,7 @@ struct PipelineParams {
   // inner regions add near-copies of R1's best boxes, which take the top ranks from distinct
   // boxes: on real frames more layers then *lowered* recall (README, "Real frames").
   float region_merge_iou = 0.75f;
+  PriorCorrection prior_correction;
   FusionParams fusion;
   ProbabilityMapParams probability_map;
 };

@@ -151,7 +151,7 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
     return Status::InvalidArgument("the bundle's R1 does not cover the frame");
   // The detector's own stage calls (ObstacleDetector::Detect).
   const OcclusionEdges oaocc = ComputeOcclusionEdges(bgr, regions, *bundle.edges, &bundle.occlusion,
-                                                     bundle.params.superpixels, /*enhance=*/true);
+                                                     bundle.params, /*enhance=*/true);
   const SizeFilter* size_filter = bundle.params.size_filter ? &geometry.size_filter : nullptr;
 
   StageImages out;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <mutex>
 
+#include "core/edges/edge_labels.h"
 #include "core/pipeline/dataset_factory.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/obstacle_detector.h"
@@ -33,6 +34,9 @@ ProposalSet Subset(const ProposalSet& all, const std::vector<int>& indices) {
 cv::Mat1i LabelMap(const Sample& sample) {
   cv::Mat1i labels(sample.image.size(), 0);
   labels.setTo(1, sample.road);
+  // Void (LAF instanceIds < 1000, the mask benchmarks' 255) stays void in every target (§3.4):
+  // the ego-vehicle hood and the rectification border are no object boundaries.
+  if (!sample.ignore.empty()) labels.setTo(kIgnoreLabel, sample.ignore);
   for (std::size_t i = 0; i < sample.instances.size(); ++i) {
     const ObstacleInstance& inst = sample.instances[i];
     const Box b = ClipToImage(inst.box, labels.cols, labels.rows);
@@ -120,8 +124,12 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
     PixelEdgeParams edge_params = options.edge_params;
     edge_params.forest.seed = options.seed;
     say("training the pixel edge classifier on " + std::to_string(edge_frames.size()) + " frames");
-    bundle.edges =
-        std::make_shared<PixelEdgeClassifier>(PixelEdgeClassifier::Train(edge_frames, edge_params));
+    auto classifier = PixelEdgeClassifier::TryTrain(edge_frames, edge_params);
+    if (!classifier.ok())
+      return classifier.status().WithContext("training the pixel edge classifier");
+    bundle.params.prior_correction.edge_odds =
+        options.prior_correction ? classifier->sampled_odds_scale() : 1.0;
+    bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*classifier));
   } else if (options.edge_source == "gradient") {
     bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
   } else if (options.edge_source == "sed") {
@@ -140,7 +148,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   (void)ParallelFor(static_cast<int>(classifier_ids.size()), options.threads, [&](int j) {
     const Sample& s = frames[classifier_ids[j]];
     OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges, nullptr,
-                                                 bundle.params.superpixels, /*enhance=*/true);
+                                                 bundle.params, /*enhance=*/true);
     occlusion_frames[j] = {oaocc.crop.clone(), oaocc.enhanced, oaocc.superpixels,
                            LabelMap(s)(oaocc.r1.rect()).clone()};
     return Status::Ok();
@@ -149,7 +157,11 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   occlusion_params.forest.seed = options.seed;
   say("training the occlusion classifier on " + std::to_string(occlusion_frames.size()) +
       " frames");
-  bundle.occlusion = OcclusionClassifier::Train(occlusion_frames, occlusion_params);
+  auto occlusion = OcclusionClassifier::Fit(occlusion_frames, occlusion_params);
+  if (!occlusion.ok()) return occlusion.status().WithContext("training the occlusion classifier");
+  bundle.occlusion = std::move(*occlusion);
+  bundle.params.prior_correction.occlusion_odds =
+      options.prior_correction ? bundle.occlusion.sampled_odds_scale() : 1.0;
   occlusion_frames.clear();
   const double occlusion_seconds = SecondsSince(t0);
 
@@ -164,9 +176,8 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   (void)ParallelFor(n, options.threads, [&](int i) {
     const Sample& s = frames[i];
     if (cv::countNonZero(s.road) > 0) {
-      const OcclusionEdges oaocc =
-          ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges, &bundle.occlusion,
-                                bundle.params.superpixels, true);
+      const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges,
+                                                         &bundle.occlusion, bundle.params, true);
       const ProposalOptions popts =
           DetectorProposalOptions(bundle.params, bundle.regions.num_layers());
       const ProposalSet all =

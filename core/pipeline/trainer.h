@@ -24,9 +24,10 @@ struct TrainOptions {
   std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
   std::string sed_model;                     // model file for edge_source "sed"
   std::uint64_t seed = 1;
-  int max_frames = 0;          // 0 = the whole split
-  int classifier_frames = 60;  // frames used for the edge and occlusion classifiers
-  int threads = 0;             // 0 = all cores
+  int max_frames = 0;            // 0 = the whole split
+  int classifier_frames = 60;    // frames used for the edge and occlusion classifiers
+  int threads = 0;               // 0 = all cores
+  bool prior_correction = true;  // undo the classifiers' balanced sampling (PriorCorrection)
   PipelineParams params;
   PixelEdgeParams edge_params;
   OcclusionParams occlusion_params;
@@ -37,7 +38,8 @@ struct TrainOptions {
 
 Result<ModelBundle> TrainModel(const TrainOptions& options);
 
-// Per-pixel labels for classifier training: 1 road, 2 + i obstacle instance i, 0 everything else.
+// Per-pixel labels for classifier training: 1 road (free space), 2 + i obstacle instance i,
+// kIgnoreLabel (-1) void, 0 everything else.
 cv::Mat1i LabelMap(const Sample& sample);
 
 }  // namespace tod

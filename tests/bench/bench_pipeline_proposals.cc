@@ -89,9 +89,8 @@ int main(int argc, char** argv) {
   std::vector<cv::Size> region_sizes(static_cast<size_t>(layers));
   for (int f = 0; f < frames; ++f) {
     const tod::Sample frame = tod::GenerateSynthFrame(synth, 1000 + static_cast<unsigned>(f), "b");
-    const tod::OcclusionEdges oaocc =
-        tod::ComputeOcclusionEdges(frame.image, geometry.regions, *bundle->edges,
-                                   &bundle->occlusion, bundle->params.superpixels, true);
+    const tod::OcclusionEdges oaocc = tod::ComputeOcclusionEdges(
+        frame.image, geometry.regions, *bundle->edges, &bundle->occlusion, bundle->params, true);
     std::vector<double> frame_ms(configs.size(), 0.0);
     for (int k = 0; k < layers; ++k) {
       const cv::Mat1f map = tod::NormaliseToMax(tod::RegionEdgeMap(oaocc, geometry.regions, k));

@@ -1,0 +1,49 @@
+#include "core/pipeline/frame_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tod {
+
+Box FrameMapping::Map(const Box& b) const {
+  const int x0 = static_cast<int>(std::floor(b.x * scale + dx));
+  const int y0 = static_cast<int>(std::floor(b.y * scale + dy));
+  const int x1 = static_cast<int>(std::ceil(b.right() * scale + dx));
+  const int y1 = static_cast<int>(std::ceil(b.bottom() * scale + dy));
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+FrameMapping MappingForFrame(int train_width, int train_height, int width, int height) {
+  FrameMapping m;
+  if (train_width <= 0 || train_height <= 0) return m;
+  m.scale = static_cast<double>(width) / train_width;
+  m.dx = 0.5 * width - m.scale * 0.5 * train_width;  // 0: the widths match by construction
+  m.dy = 0.5 * height - m.scale * 0.5 * train_height;
+  return m;
+}
+
+FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height) {
+  FrameGeometry g;
+  g.size_filter = bundle.size_filter;
+  const MultilayerRegions& trained = bundle.regions;
+  if (width == trained.image_width && height == trained.image_height) {
+    g.regions = trained;
+    return g;
+  }
+  const FrameMapping m = MappingForFrame(trained.image_width, trained.image_height, width, height);
+  g.regions.image_width = width;
+  g.regions.image_height = height;
+  for (const Box& r : trained.layers)
+    g.regions.layers.push_back(ClipToImage(m.Map(r), width, height));
+  const double s = m.scale;
+  for (SizeBand& b : g.size_filter.bands) {
+    b.center_y_min = b.center_y_min * s + m.dy;
+    b.center_y_max = b.center_y_max * s + m.dy;
+    b.h_min *= s, b.h_max *= s;
+    b.w_min *= s, b.w_max *= s;
+    b.area_min *= s * s, b.area_max *= s * s;
+  }
+  return g;
+}
+
+}  // namespace tod

@@ -1,0 +1,35 @@
+// The geometry a bundle learned at its training resolution (multilayer regions, size filter),
+// mapped onto a frame of any size without stretching it.
+//
+// A camera frame of another size is taken to show the scene with the same horizontal field of
+// view and the same camera pitch, principal point at the centre (the usual case for forward
+// road cameras: 2048 x 1024 Lost and Found, 1920 x 1080 and 1280 x 720 dash cameras). Pixel
+// lengths then scale by one factor s = width / training width, and a row keeps its offset from
+// the image centre times s. So a 2048 x 1024 bundle on a 1920 x 1080 frame uses s = 0.9375 and
+// shifts rows by +60 px (the taller frame shows more above and below); on 1280 x 720, s = 0.625.
+// Regions are clipped to the frame.
+#pragma once
+
+#include "core/pipeline/model_bundle.h"
+
+namespace tod {
+
+// x' = s x + dx, y' = s y + dy.
+struct FrameMapping {
+  double scale = 1.0;
+  double dx = 0.0;
+  double dy = 0.0;
+  Box Map(const Box& b) const;
+};
+
+// The mapping from the training frame (train_w x train_h) to a frame of width x height.
+FrameMapping MappingForFrame(int train_width, int train_height, int width, int height);
+
+// Regions and size filter of a bundle for frames of a given size.
+struct FrameGeometry {
+  MultilayerRegions regions;
+  SizeFilter size_filter;
+};
+FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height);
+
+}  // namespace tod
