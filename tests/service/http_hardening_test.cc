@@ -147,7 +147,8 @@ TEST(HttpHardeningOwnServerTest, EndlessHeaderLineIsCutAtTheLimit) {
 // so the liveness probe stopped answering for as long as they trickled.
 TEST(HttpHardeningOwnServerTest, TricklingClientsNeitherBlockProbesNorStayForever) {
   REQUIRE_MODEL();
-  auto server = StartServer({"--http-request-timeout", "20"});
+  // Default limits: the whole-request deadline is 30 s.
+  auto server = StartServer({});
   ASSERT_TRUE(server->WaitReady()) << server->Log();
   constexpr int kTricklers = 16;
   std::vector<std::unique_ptr<RawConnection>> tricklers;
@@ -160,19 +161,22 @@ TEST(HttpHardeningOwnServerTest, TricklingClientsNeitherBlockProbesNorStayForeve
                      "Content-Length: 100000\r\n\r\n"));
   }
   std::atomic<int> answered{0};
+  std::atomic<bool> give_up{false};
   std::vector<int> statuses(kTricklers, 0);
   std::thread trickle([&] {
     // One byte a second on every connection still waiting, until each has its answer
-    // (bounded: 120 rounds, far beyond the 20 s request deadline).
-    for (int round = 0; round < 120 && answered < kTricklers; ++round) {
+    // (bounded: 120 rounds, far beyond the 30 s request deadline).
+    for (int round = 0; round < 120 && answered < kTricklers && !give_up; ++round) {
       for (int i = 0; i < kTricklers; ++i) {
-        if (statuses[static_cast<size_t>(i)] != 0) continue;
-        if (tricklers[static_cast<size_t>(i)]->Readable(0ms)) {
-          const auto response = tricklers[static_cast<size_t>(i)]->ReadResponse(10s);
-          statuses[static_cast<size_t>(i)] = response ? response->status : -1;
+        RawConnection& connection = *tricklers[static_cast<size_t>(i)];
+        int& status = statuses[static_cast<size_t>(i)];
+        if (status != 0) continue;
+        if (connection.Readable(0ms)) {
+          const auto response = connection.ReadResponse(10s);
+          status = response ? response->status : -1;
           ++answered;
         } else {
-          tricklers[static_cast<size_t>(i)]->Send("a");
+          connection.Send("a");
         }
       }
       std::this_thread::sleep_for(1s);
@@ -182,20 +186,26 @@ TEST(HttpHardeningOwnServerTest, TricklingClientsNeitherBlockProbesNorStayForeve
   httplib::Client probe("127.0.0.1", server->http_port());
   probe.set_connection_timeout(10s);
   probe.set_read_timeout(10s);
+  int probes_answered = 0;
   int probes_while_trickling = 0;
   for (int i = 0; i < 5; ++i) {
     const auto live = probe.Get("/v2/health/live");
-    ASSERT_TRUE(live) << "liveness probe not answered while clients trickle";
+    if (!live) break;
     EXPECT_EQ(live->status, 200);
+    ++probes_answered;
     if (answered == 0) ++probes_while_trickling;
   }
-  probe.set_read_timeout(60s);
-  const auto detect = probe.Post("/v1/detect?map=none", testing::RoadPng(), "image/png");
-  ASSERT_TRUE(detect);
-  EXPECT_EQ(detect->status, 200);
-  EXPECT_GE(probes_while_trickling, 1) << "the trickling clients were cut before any probe";
+  int detect_status = -1;
+  if (probes_answered == 5) {
+    probe.set_read_timeout(60s);
+    const auto detect = probe.Post("/v1/detect?map=none", testing::RoadPng(), "image/png");
+    detect_status = detect ? detect->status : -1;
+  }
+  give_up = probes_answered < 5;
   trickle.join();
-  // And the trickling clients are cut at the whole-request deadline, however they trickle.
+  EXPECT_EQ(probes_answered, 5) << "liveness probe not answered while clients trickle";
+  EXPECT_EQ(detect_status, 200);
+  EXPECT_GE(probes_while_trickling, 1) << "the trickling clients were cut before any probe";
   EXPECT_EQ(statuses, std::vector<int>(kTricklers, 408));
   EXPECT_EQ(Refused(server->http_port(), "read_timeout"), kTricklers);
 }
