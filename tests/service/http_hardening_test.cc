@@ -338,6 +338,30 @@ TEST_F(HttpHardeningTest, MalformedProtobufIsInvalidArgumentWithMessage) {
           << method << ": '" << status.error_message() << "'";
     }
   }
+  // A malformed frame in a stream ends the stream with INVALID_ARGUMENT naming the frame.
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + 30s);
+  grpc::CompletionQueue queue;
+  auto stream = stub.PrepareCall(&context, "/tod.v1.ObstacleDiscovery/DetectStream", &queue);
+  void* tag = nullptr;
+  bool ok = false;
+  auto step = [&] { ASSERT_TRUE(queue.Next(&tag, &ok)); };
+  stream->StartCall(reinterpret_cast<void*>(1));
+  step();
+  grpc::Slice slice(truncated_field);
+  stream->Write(grpc::ByteBuffer(&slice, 1), reinterpret_cast<void*>(2));
+  step();
+  stream->WritesDone(reinterpret_cast<void*>(3));
+  step();
+  grpc::Status stream_status;
+  stream->Finish(&stream_status, reinterpret_cast<void*>(4));
+  step();
+  queue.Shutdown();
+  while (queue.Next(&tag, &ok)) {
+  }
+  EXPECT_EQ(stream_status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(stream_status.error_message().find("frame 0: malformed"), std::string::npos)
+      << stream_status.error_message();
   // Well-formed requests still work through the same raw methods.
   client::TodGrpcClient grpc(server_->grpc_address());
   tod::v1::ModelInfo info;
