@@ -446,6 +446,51 @@ TEST(HttpHardeningOwnServerTest, ConnectionsPerClientAreCapped) {
       << metrics;
 }
 
+TEST(HttpHardeningOwnServerTest, BodyBytesInFlightShareOneBudget) {
+  REQUIRE_MODEL();
+  // Room for exactly one body of the maximum size.
+  auto server =
+      StartServer({"--max-image-bytes", "1000000", "--http-max-buffered-bytes", "1000000"});
+  ASSERT_TRUE(server->WaitReady()) << server->Log();
+  RawConnection holder(server->http_port());
+  ASSERT_TRUE(
+      holder.Send("POST /v1/detect HTTP/1.1\r\nHost: t\r\nContent-Type: image/png\r\n"
+                  "Content-Length: 1000000\r\n\r\n"));
+  // Once the holder's header is read, its whole declared body is charged: any other body is
+  // refused until the holder is done (retried: the holder's header is read asynchronously).
+  const std::string small =
+      "POST /v1/detect HTTP/1.1\r\nHost: t\r\nContent-Type: image/png\r\n"
+      "Content-Length: 10\r\n\r\n0123456789";
+  int status = 0;
+  for (int attempt = 0; attempt < 100 && status != 503; ++attempt) {
+    RawConnection other(server->http_port());
+    if (other.Send(small)) {
+      const auto response = other.ReadResponse(15s);
+      status = response ? response->status : -1;
+    }
+    if (status != 503) std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_EQ(status, 503);
+  // The holder finishes its body (not an image: 400) and gives the budget back.
+  ASSERT_TRUE(holder.Send(std::string(1000000, 'x')));
+  const auto held = holder.ReadResponse(30s);
+  ASSERT_TRUE(held);
+  EXPECT_EQ(held->status, 400);
+  // Admitted again (the budget comes back just after the holder's answer is written; bounded
+  // retries): the 10 bytes are not an image.
+  int after = 0;
+  for (int attempt = 0; attempt < 100 && after != 400; ++attempt) {
+    RawConnection again(server->http_port());
+    if (again.Send(small)) {
+      const auto response = again.ReadResponse(15s);
+      after = response ? response->status : -1;
+    }
+    if (after != 400) std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_EQ(after, 400);
+  EXPECT_GE(Refused(server->http_port(), "buffer_budget"), 1);
+}
+
 TEST(HttpHardeningOwnServerTest, SilentConnectionsAreClosedAtTheIdleTimeout) {
   REQUIRE_MODEL();
   auto server = StartServer({"--http-idle-timeout", "1"});
