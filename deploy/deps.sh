@@ -11,17 +11,25 @@ BUILD_PACKAGES=(
   libopencv-dev libopencv-contrib-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libeigen3-dev libspdlog-dev libfmt-dev nlohmann-json3-dev libcli11-dev
-  prometheus-cpp-dev libcpp-httplib-dev libmatio-dev
+  prometheus-cpp-dev libmatio-dev
+  libboost-dev libjpeg62-turbo-dev libpng-dev
+  libcpp-httplib-dev
   libgtest-dev libgmock-dev
 )
+# libboost-dev: Boost.Beast/Asio (header-only) for tod_server's REST transport.
+# libjpeg62-turbo-dev, libpng-dev: tod_server's strict image decoders.
+# libcpp-httplib-dev: only the HTTP client of tod_load and of the tests (not the server).
 
 RUNTIME_PACKAGES=(
   ca-certificates tini
   libopencv-core406 libopencv-imgproc406 libopencv-imgcodecs406 libopencv-ml406
   libopencv-contrib406
   libgrpc++1.51 libgrpc29 libprotobuf32
-  libspdlog1.10 libfmt9 libprometheus-cpp-core1.0 libcpp-httplib0.11 libmatio11
+  libspdlog1.10 libfmt9 libprometheus-cpp-core1.0 libmatio11
+  libjpeg62-turbo libpng16-16
+  libcpp-httplib0.11
 )
+# libcpp-httplib0.11: tod_load's HTTP client; tod_server does not load it.
 
 usage() {
   echo "usage: $0 build|runtime|--print [build|runtime]" >&2

@@ -36,12 +36,27 @@ const std::vector<SettingSpec>& SettingSpecs() {
       {"max_image_bytes", "max-image-bytes", "TOD_MAX_IMAGE_BYTES",
        "Largest encoded image accepted, bytes (default 16 MiB)"},
       {"max_image_pixels", "max-image-pixels", "TOD_MAX_IMAGE_PIXELS",
-       "Largest image accepted, width*height (default 16e6, at most 1e8)"},
+       "Largest image accepted, width*height (default 4e6, at most 1e8)"},
       {"drain_timeout_s", "drain-timeout", "TOD_DRAIN_TIMEOUT",
        "Seconds SIGTERM waits for queued and running work (default 20)"},
       {"retry_after_s", "retry-after", "TOD_RETRY_AFTER",
        "Retry-After seconds sent with 503 queue-full (default 1)"},
-      {"http_threads", "http-threads", "TOD_HTTP_THREADS", "REST connection threads (default 16)"},
+      {"http_threads", "http-threads", "TOD_HTTP_THREADS", "REST I/O threads (default 2)"},
+      {"http_max_connections", "http-max-connections", "TOD_HTTP_MAX_CONNECTIONS",
+       "Open REST connections allowed (default 512)"},
+      {"http_max_connections_per_client", "http-max-connections-per-client",
+       "TOD_HTTP_MAX_CONNECTIONS_PER_CLIENT",
+       "Open REST connections allowed from one client address (default 64)"},
+      {"http_max_header_bytes", "http-max-header-bytes", "TOD_HTTP_MAX_HEADER_BYTES",
+       "Request line + headers, bytes (default 16384)"},
+      {"http_max_buffered_bytes", "http-max-buffered-bytes", "TOD_HTTP_MAX_BUFFERED_BYTES",
+       "Request body bytes all REST connections may hold together (default 256 MiB)"},
+      {"http_request_timeout_s", "http-request-timeout", "TOD_HTTP_REQUEST_TIMEOUT",
+       "Seconds from a request's first byte to its last (default 30)"},
+      {"http_idle_timeout_s", "http-idle-timeout", "TOD_HTTP_IDLE_TIMEOUT",
+       "Seconds a REST connection may wait idle for its next request (default 60)"},
+      {"http_write_timeout_s", "http-write-timeout", "TOD_HTTP_WRITE_TIMEOUT",
+       "Seconds allowed for writing one response (default 30)"},
       {"log_format", "log-format", "TOD_LOG_FORMAT", "text | json (default text)"},
       {"log_level", "log-level", "TOD_LOG_LEVEL", "trace|debug|info|warn|error (default info)"},
   };
@@ -73,6 +88,20 @@ Status ApplySetting(const std::string& key, const std::string& value, const std:
     return ParseNumber(value, what, &config->retry_after_s);
   } else if (key == "http_threads") {
     return ParseNumber(value, what, &config->http_threads);
+  } else if (key == "http_max_connections") {
+    return ParseNumber(value, what, &config->http_max_connections);
+  } else if (key == "http_max_connections_per_client") {
+    return ParseNumber(value, what, &config->http_max_connections_per_client);
+  } else if (key == "http_max_header_bytes") {
+    return ParseNumber(value, what, &config->http_max_header_bytes);
+  } else if (key == "http_max_buffered_bytes") {
+    return ParseNumber(value, what, &config->http_max_buffered_bytes);
+  } else if (key == "http_request_timeout_s") {
+    return ParseNumber(value, what, &config->http_request_timeout_s);
+  } else if (key == "http_idle_timeout_s") {
+    return ParseNumber(value, what, &config->http_idle_timeout_s);
+  } else if (key == "http_write_timeout_s") {
+    return ParseNumber(value, what, &config->http_write_timeout_s);
   } else if (key == "log_format") {
     config->log_format = value;
   } else if (key == "log_level") {
@@ -158,10 +187,39 @@ Status ValidateServerConfig(const ServerConfig& config) {
     return Status::InvalidArgument("max_image_pixels: must be in 1.." +
                                    std::to_string(kAbsoluteMaxPixels));
   }
-  if (!(config.drain_timeout_s >= 0)) return Status::InvalidArgument("drain_timeout_s: < 0");
-  if (config.retry_after_s < 0) return Status::InvalidArgument("retry_after_s: must be >= 0");
-  if (config.http_threads < 1 || config.http_threads > 1024) {
-    return Status::InvalidArgument("http_threads: must be in 1..1024");
+  if (!(config.drain_timeout_s >= 0 && config.drain_timeout_s <= 86400)) {
+    return Status::InvalidArgument("drain_timeout_s: must be in 0..86400 seconds");
+  }
+  if (config.retry_after_s < 0 || config.retry_after_s > 3600) {
+    return Status::InvalidArgument("retry_after_s: must be in 0..3600");
+  }
+  if (config.http_threads < 1 || config.http_threads > 64) {
+    return Status::InvalidArgument("http_threads: must be in 1..64");
+  }
+  if (config.http_max_connections < 1 || config.http_max_connections > 100'000) {
+    return Status::InvalidArgument("http_max_connections: must be in 1..100000");
+  }
+  if (config.http_max_connections_per_client < 1 ||
+      config.http_max_connections_per_client > config.http_max_connections) {
+    return Status::InvalidArgument(
+        "http_max_connections_per_client: must be in 1..http_max_connections");
+  }
+  if (config.http_max_header_bytes < 1024 || config.http_max_header_bytes > (1u << 20)) {
+    return Status::InvalidArgument("http_max_header_bytes: must be in 1024..1048576");
+  }
+  if (config.http_max_buffered_bytes < config.max_image_bytes ||
+      config.http_max_buffered_bytes > (size_t{1} << 36)) {
+    return Status::InvalidArgument(
+        "http_max_buffered_bytes: must be at least max_image_bytes and at most 64 GiB");
+  }
+  const std::pair<const char*, double> timeouts[] = {
+      {"http_request_timeout_s", config.http_request_timeout_s},
+      {"http_idle_timeout_s", config.http_idle_timeout_s},
+      {"http_write_timeout_s", config.http_write_timeout_s}};
+  for (const auto& [name, seconds] : timeouts) {
+    if (!(seconds >= 0.1 && seconds <= 3600)) {  // also refuses NaN
+      return Status::InvalidArgument(std::string(name) + ": must be in 0.1..3600 seconds");
+    }
   }
   if (config.log_format != "text" && config.log_format != "json") {
     return Status::InvalidArgument("log_format: '" + config.log_format + "' is not text or json");
@@ -186,6 +244,13 @@ nlohmann::json ServerConfigToJson(const ServerConfig& config) {
           {"drain_timeout_s", config.drain_timeout_s},
           {"retry_after_s", config.retry_after_s},
           {"http_threads", config.http_threads},
+          {"http_max_connections", config.http_max_connections},
+          {"http_max_connections_per_client", config.http_max_connections_per_client},
+          {"http_max_header_bytes", config.http_max_header_bytes},
+          {"http_max_buffered_bytes", config.http_max_buffered_bytes},
+          {"http_request_timeout_s", config.http_request_timeout_s},
+          {"http_idle_timeout_s", config.http_idle_timeout_s},
+          {"http_write_timeout_s", config.http_write_timeout_s},
           {"log_format", config.log_format},
           {"log_level", config.log_level}};
 }

@@ -21,12 +21,22 @@ struct ServerConfig {
   int workers = 0;                     // 0: one per core
   int queue = 64;                      // requests waiting for a worker
   size_t max_image_bytes = 16u << 20;  // encoded request body
-  long long max_image_pixels = 16'000'000;
-  double drain_timeout_s = 20;      // SIGTERM: time allowed for queued + running work
-  int retry_after_s = 1;            // Retry-After on 503 (queue full)
-  int http_threads = 16;            // REST connection threads
-  std::string log_format = "text";  // text | json
-  std::string log_level = "info";   // trace | debug | info | warn | error
+  // The shipped model's camera frames are 2048 x 1024 (2.1 MP); 4 MP leaves headroom while a
+  // bigger frame would only cost seconds of CPU and hundreds of MB per request.
+  long long max_image_pixels = 4'000'000;
+  double drain_timeout_s = 20;  // SIGTERM: time allowed for queued + running work
+  int retry_after_s = 1;        // Retry-After on 503 (queue full)
+  int http_threads = 2;         // REST I/O threads (connections are asynchronous)
+  // REST transport limits (server/http/http_limits.h).
+  int http_max_connections = 512;
+  int http_max_connections_per_client = 64;
+  size_t http_max_header_bytes = 16 * 1024;
+  size_t http_max_buffered_bytes = 256u << 20;
+  double http_request_timeout_s = 30;  // first byte to last body byte of one request
+  double http_idle_timeout_s = 60;     // connection without a request in progress
+  double http_write_timeout_s = 30;    // writing one response
+  std::string log_format = "text";     // text | json
+  std::string log_level = "info";      // trace | debug | info | warn | error
 };
 
 // Absolute pixel ceiling no configuration may exceed (decompression-bomb guard).

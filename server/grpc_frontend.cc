@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "server/detect_response.h"
+#include "server/grpc_messages.h"
 #include "server/logging.h"
 #include "server/status_mapping.h"
 
@@ -25,7 +26,7 @@ std::optional<std::chrono::steady_clock::time_point> SteadyDeadline(
 // One frame at a time per stream: read, run, write, read the next. Responses therefore come back
 // in request order, and a stream holds at most one queue slot.
 class DetectStreamReactor final
-    : public grpc::ServerBidiReactor<tod::v1::DetectRequest, tod::v1::DetectResponse> {
+    : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer> {
  public:
   DetectStreamReactor(ObstacleDiscoveryService& service, grpc::CallbackServerContext* context)
       : service_(service), context_(context) {
@@ -64,8 +65,8 @@ class DetectStreamReactor final
  private:
   ObstacleDiscoveryService& service_;
   grpc::CallbackServerContext* const context_;
-  tod::v1::DetectRequest request_;
-  tod::v1::DetectResponse response_;
+  grpc::ByteBuffer request_;
+  grpc::ByteBuffer response_;
   long long frame_index_ = 0;
 };
 
@@ -81,63 +82,87 @@ std::string ObstacleDiscoveryService::NextRequestId() {
 }
 
 void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
-                                           const tod::v1::DetectRequest& request,
+                                           const grpc::ByteBuffer& request_bytes,
                                            const std::string& default_frame_id,
-                                           tod::v1::DetectResponse* response,
+                                           grpc::ByteBuffer* response,
                                            std::function<void(grpc::Status)> done) {
-  const RequestOptions options = OptionsFromProto(request.options());
+  const std::string request_id = NextRequestId();
+  const std::string peer = context->peer();
+  auto log = [this, request_id, peer](const std::string& frame_id, size_t bytes,
+                                      const grpc::Status& status, double ms) {
+    const std::string code = GrpcCodeName(status.error_code());
+    metrics_.RecordRequest("grpc", code, ms / 1000.0);
+    nlohmann::json fields = {{"id", request_id}, {"protocol", "grpc"}, {"frame", frame_id},
+                             {"peer", peer},     {"bytes", bytes},     {"status", code},
+                             {"ms", ms}};
+    if (!status.ok()) fields["error"] = status.error_message();
+    LogEvent(status.ok() ? spdlog::level::info : spdlog::level::warn, "detect", fields);
+  };
+
+  // Owned here (not by gRPC) so the image bytes live until the engine's completion has run.
+  auto request = std::make_shared<tod::v1::DetectRequest>();
+  if (Status parsed = ParseMessage(request_bytes, request.get()); !parsed.ok()) {
+    metrics_.RecordRejection("bad_request");
+    const grpc::Status status = ToGrpcStatus(parsed);
+    log(default_frame_id.empty() ? request_id : default_frame_id, request_bytes.Length(), status,
+        0);
+    done(status);
+    return;
+  }
+  const RequestOptions options = OptionsFromProto(request->options());
   InferenceRequest inference;
-  inference.image = request.image();
+  inference.image = request->image();
   inference.options = options.detect;
   inference.encode_map_png = options.encode_map_png;
   inference.deadline = SteadyDeadline(*context);
-  const std::string request_id = NextRequestId();
-  const std::string frame_id = !request.frame_id().empty() ? request.frame_id()
-                               : !default_frame_id.empty() ? default_frame_id
-                                                           : request_id;
-  const size_t bytes = request.image().size();
-  const std::string peer = context->peer();
-  engine_.Submit(inference, [this, response, frame_id, request_id, bytes, peer,
+  const std::string frame_id = !request->frame_id().empty() ? request->frame_id()
+                               : !default_frame_id.empty()  ? default_frame_id
+                                                            : request_id;
+  engine_.Submit(inference, [request, response, frame_id, log = std::move(log),
                              done = std::move(done)](InferenceResult result) {
-    const grpc::Status status = ToGrpcStatus(result.status);
-    if (status.ok()) FillDetectResponse(result, frame_id, response);
-    const std::string code = GrpcCodeName(status.error_code());
-    metrics_.RecordRequest("grpc", code, result.total_ms / 1000.0);
-    nlohmann::json fields = {{"id", request_id},     {"protocol", "grpc"}, {"frame", frame_id},
-                             {"peer", peer},         {"bytes", bytes},     {"status", code},
-                             {"ms", result.total_ms}};
-    if (!status.ok()) fields["error"] = status.error_message();
-    LogEvent(status.ok() ? spdlog::level::info : spdlog::level::warn, "detect", fields);
+    grpc::Status status = ToGrpcStatus(result.status);
+    if (status.ok()) {
+      tod::v1::DetectResponse message;
+      FillDetectResponse(result, frame_id, &message);
+      status = ToGrpcStatus(SerializeMessage(message, response));
+    }
+    log(frame_id, request->image().size(), status, result.total_ms);
     done(status);
   });
 }
 
 grpc::ServerUnaryReactor* ObstacleDiscoveryService::Detect(grpc::CallbackServerContext* context,
-                                                           const tod::v1::DetectRequest* request,
-                                                           tod::v1::DetectResponse* response) {
+                                                           const grpc::ByteBuffer* request,
+                                                           grpc::ByteBuffer* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   SubmitFrame(context, *request, "", response,
               [reactor](grpc::Status status) { reactor->Finish(status); });
   return reactor;
 }
 
-grpc::ServerBidiReactor<tod::v1::DetectRequest, tod::v1::DetectResponse>*
-ObstacleDiscoveryService::DetectStream(grpc::CallbackServerContext* context) {
+grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* ObstacleDiscoveryService::DetectStream(
+    grpc::CallbackServerContext* context) {
   return new DetectStreamReactor(*this, context);  // deletes itself in OnDone
 }
 
 grpc::ServerUnaryReactor* ObstacleDiscoveryService::GetModelInfo(
-    grpc::CallbackServerContext* context, const tod::v1::GetModelInfoRequest* /*request*/,
-    tod::v1::ModelInfo* response) {
+    grpc::CallbackServerContext* context, const grpc::ByteBuffer* request,
+    grpc::ByteBuffer* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  grpc::Status status;
+  tod::v1::GetModelInfoRequest parsed;
   const std::shared_ptr<const LoadedModel> model = models_.Current();
-  if (!model) {
-    reactor->Finish(grpc::Status(grpc::StatusCode::UNAVAILABLE, "model not loaded yet"));
+  if (Status valid = ParseMessage(*request, &parsed); !valid.ok()) {
+    status = ToGrpcStatus(valid);
+  } else if (!model) {
+    status = grpc::Status(grpc::StatusCode::UNAVAILABLE, "model not loaded yet");
   } else {
-    FillModelInfo(*model, response);
-    reactor->Finish(grpc::Status::OK);
+    tod::v1::ModelInfo info;
+    FillModelInfo(*model, &info);
+    status = ToGrpcStatus(SerializeMessage(info, response));
   }
-  metrics_.RecordRequest("grpc", model ? "OK" : "UNAVAILABLE", 0);
+  metrics_.RecordRequest("grpc", GrpcCodeName(status.error_code()), 0);
+  reactor->Finish(status);
   return reactor;
 }
 

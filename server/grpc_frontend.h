@@ -1,5 +1,7 @@
 // gRPC frontend: thin callback-API service classes that translate tod.v1 messages to engine
-// requests and engine results back to messages and status codes.
+// requests and engine results back to messages and status codes. The methods are registered raw
+// (ByteBuffer in and out) and parse their requests themselves, so that a malformed request gets
+// INVALID_ARGUMENT with a message (see grpc_messages.h).
 #pragma once
 
 #include <grpcpp/grpcpp.h>
@@ -15,24 +17,30 @@
 
 namespace tod::server {
 
-class ObstacleDiscoveryService final : public tod::v1::ObstacleDiscovery::CallbackService {
+using RawObstacleDiscoveryService = tod::v1::ObstacleDiscovery::WithRawCallbackMethod_Detect<
+    tod::v1::ObstacleDiscovery::WithRawCallbackMethod_DetectStream<
+        tod::v1::ObstacleDiscovery::WithRawCallbackMethod_GetModelInfo<
+            tod::v1::ObstacleDiscovery::Service>>>;
+
+class ObstacleDiscoveryService final : public RawObstacleDiscoveryService {
  public:
   // All three must outlive the service.
   ObstacleDiscoveryService(InferenceEngine& engine, const ModelHolder& models,
                            ServerMetrics& metrics);
 
   grpc::ServerUnaryReactor* Detect(grpc::CallbackServerContext* context,
-                                   const tod::v1::DetectRequest* request,
-                                   tod::v1::DetectResponse* response) override;
-  grpc::ServerBidiReactor<tod::v1::DetectRequest, tod::v1::DetectResponse>* DetectStream(
+                                   const grpc::ByteBuffer* request,
+                                   grpc::ByteBuffer* response) override;
+  grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* DetectStream(
       grpc::CallbackServerContext* context) override;
   grpc::ServerUnaryReactor* GetModelInfo(grpc::CallbackServerContext* context,
-                                         const tod::v1::GetModelInfoRequest* request,
-                                         tod::v1::ModelInfo* response) override;
+                                         const grpc::ByteBuffer* request,
+                                         grpc::ByteBuffer* response) override;
 
-  // Used by the stream reactor: submits one frame; `done` gets the status and filled response.
-  void SubmitFrame(grpc::CallbackServerContext* context, const tod::v1::DetectRequest& request,
-                   const std::string& default_frame_id, tod::v1::DetectResponse* response,
+  // Parses and submits one frame; `done` gets the status and, when OK, the serialised
+  // DetectResponse in `response`. `done` may run inline or on a worker thread.
+  void SubmitFrame(grpc::CallbackServerContext* context, const grpc::ByteBuffer& request,
+                   const std::string& default_frame_id, grpc::ByteBuffer* response,
                    std::function<void(grpc::Status)> done);
   std::string NextRequestId();
 

@@ -1,36 +1,38 @@
-// REST frontend on cpp-httplib. Detection requests go through the same engine (queue, workers,
-// limits) as gRPC; the JSON is the proto3 JSON form of the same tod.v1 messages.
+// REST frontend: the tod REST API on the bounded HTTP transport (server/http/). Detection
+// requests go through the same engine (queue, workers, limits) as gRPC; the JSON is the proto3
+// JSON form of the same tod.v1 messages.
 //
 //   POST /v1/detect             body: JPEG/PNG; query: max_proposals, obstacle_threshold,
 //                               map=png|none, frame_id, timeout_ms  -> DetectResponse JSON
 //   POST /v1/probability-map    same input                          -> image/png map
 //   GET  /v1/model                                                   -> ModelInfo JSON
 //   GET  /v2/health/live, /v2/health/ready, /metrics
+//
+// No handler blocks an I/O thread: detection answers from the engine's completion.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <thread>
 
 #include "core/base/status.h"
 #include "server/core/inference_engine.h"
 #include "server/core/model_holder.h"
+#include "server/http/http_limits.h"
 #include "server/metrics.h"
-
-namespace httplib {
-class Server;
-struct Request;
-struct Response;
-}  // namespace httplib
 
 namespace tod::server {
 
+namespace http {
+class HttpServer;
+}  // namespace http
+class RestApi;
+
 struct HttpFrontendConfig {
-  size_t max_image_bytes = 16u << 20;
+  http::HttpLimits limits;  // limits.max_body_bytes is the image byte limit
   int retry_after_s = 1;
-  int threads = 16;
+  int io_threads = 2;
 };
 
 class HttpFrontend {
@@ -43,25 +45,20 @@ class HttpFrontend {
 
   // Binds the listening socket (port 0: any free port); the port is then port().
   Status Bind(const std::string& host, int port);
-  int port() const { return port_; }
-  // Serves on a background thread until Stop().
+  int port() const;
+  // Serves on the I/O threads until Stop().
   void Start();
-  // Stops accepting, lets running handlers finish, joins.
+  // Stops accepting, lets answers being written finish (a few seconds at most), closes.
   void Stop();
 
  private:
-  void HandleDetect(const httplib::Request& request, httplib::Response& response, bool map_only);
-  void HandleModel(httplib::Response& response);
-
   const HttpFrontendConfig config_;
   InferenceEngine& engine_;
   const ModelHolder& models_;
   ServerMetrics& metrics_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
-  std::atomic<bool> listener_done_{false};  // listen_after_bind() has returned
-  int port_ = 0;
   std::atomic<uint64_t> request_counter_{0};
+  std::unique_ptr<RestApi> api_;              // the handlers the routes call
+  std::unique_ptr<http::HttpServer> server_;  // last: its connections use the members above
 };
 
 }  // namespace tod::server

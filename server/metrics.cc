@@ -45,6 +45,15 @@ ServerMetrics::ServerMetrics()
                       .Name("tod_rejections_total")
                       .Help("Requests refused, by reason")
                       .Register(*registry_)),
+      http_refused_(prometheus::BuildCounter()
+                        .Name("tod_http_refused_total")
+                        .Help("Requests or connections the HTTP front end refused, by reason")
+                        .Register(*registry_)),
+      http_connections_(prometheus::BuildGauge()
+                            .Name("tod_http_open_connections")
+                            .Help("Open REST connections")
+                            .Register(*registry_)
+                            .Add({})),
       model_info_(prometheus::BuildGauge()
                       .Name("tod_model_info")
                       .Help("The model serving (value 1), labelled with name, version, generation")
@@ -63,6 +72,12 @@ void ServerMetrics::RecordRequest(const std::string& protocol, const std::string
 void ServerMetrics::RecordRejection(const std::string& reason) {
   rejections_.Add({{"reason", reason}}).Increment();
 }
+
+void ServerMetrics::RecordHttpRefusal(const std::string& reason) {
+  http_refused_.Add({{"reason", reason}}).Increment();
+}
+
+void ServerMetrics::SetHttpConnections(double open) { http_connections_.Set(open); }
 
 void ServerMetrics::ObserveQueueWait(double seconds) { queue_duration_.Observe(seconds); }
 

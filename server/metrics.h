@@ -29,6 +29,9 @@ class ServerMetrics {
   void ObserveStages(const StageTimes& stages);  // milliseconds in, seconds exported
   void SetQueueDepth(double depth);
   void AddInFlight(double delta);
+  // The HTTP transport refused a request or connection (http::RefusalReasonName).
+  void RecordHttpRefusal(const std::string& reason);
+  void SetHttpConnections(double open);
   void SetModel(const std::string& name, const std::string& version, int generation);
   void RecordReload(bool ok);
 
@@ -43,6 +46,8 @@ class ServerMetrics {
   prometheus::Gauge& queue_depth_;
   prometheus::Gauge& in_flight_;
   prometheus::Family<prometheus::Counter>& rejections_;
+  prometheus::Family<prometheus::Counter>& http_refused_;
+  prometheus::Gauge& http_connections_;
   prometheus::Family<prometheus::Gauge>& model_info_;
   prometheus::Family<prometheus::Counter>& reloads_;
   std::mutex model_mutex_;                     // guards model_series_

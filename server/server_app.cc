@@ -12,6 +12,7 @@
 #include "server/core/inference_engine.h"
 #include "server/core/model_holder.h"
 #include "server/grpc_frontend.h"
+#include "server/http/http_limits.h"
 #include "server/http_frontend.h"
 #include "server/logging.h"
 #include "server/metrics.h"
@@ -44,6 +45,23 @@ void PublishModel(const ModelHolder& models, ServerMetrics& metrics) {
             {"generation", model->generation}});
 }
 
+std::chrono::milliseconds Milliseconds(double seconds) {
+  return std::chrono::milliseconds(static_cast<long long>(seconds * 1000));
+}
+
+http::HttpLimits HttpLimitsFrom(const ServerConfig& config) {
+  http::HttpLimits limits;
+  limits.max_header_bytes = static_cast<uint32_t>(config.http_max_header_bytes);
+  limits.max_body_bytes = config.max_image_bytes;
+  limits.max_buffered_bytes = config.http_max_buffered_bytes;
+  limits.request_timeout = Milliseconds(config.http_request_timeout_s);
+  limits.idle_timeout = Milliseconds(config.http_idle_timeout_s);
+  limits.write_timeout = Milliseconds(config.http_write_timeout_s);
+  limits.max_connections = config.http_max_connections;
+  limits.max_connections_per_client = config.http_max_connections_per_client;
+  return limits;
+}
+
 }  // namespace
 
 void BlockServerSignals() {
@@ -53,8 +71,6 @@ void BlockServerSignals() {
 
 int RunServer(const ServerConfig& config) {
   BlockServerSignals();  // before any thread starts, so all of them inherit the mask
-  // OpenCV's own decoder ceiling, as a second guard behind the header check.
-  setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(config.max_image_pixels).c_str(), 0);
   LogEvent(spdlog::level::info, "starting", ServerConfigToJson(config));
 
   ServerMetrics metrics;
@@ -92,9 +108,9 @@ int RunServer(const ServerConfig& config) {
   health->SetServingStatus(false);
 
   HttpFrontendConfig http_config;
-  http_config.max_image_bytes = config.max_image_bytes;
+  http_config.limits = HttpLimitsFrom(config);
   http_config.retry_after_s = config.retry_after_s;
-  http_config.threads = config.http_threads;
+  http_config.io_threads = config.http_threads;
   HttpFrontend http(http_config, engine, models, metrics);
   if (Status bound = http.Bind(config.host, config.http_port); !bound.ok()) {
     LogEvent(spdlog::level::err, "cannot listen for HTTP", {{"error", bound.message()}});

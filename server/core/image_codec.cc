@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "server/core/image_header.h"
+#include "server/core/strict_decoders.h"
 
 namespace tod::server {
 
@@ -23,20 +24,10 @@ Result<cv::Mat3b> DecodeImage(std::string_view bytes, const ImageLimits& limits)
                                      std::to_string(pixels) + " pixels is over the limit of " +
                                      std::to_string(limits.max_pixels) + " pixels");
   }
-  // cv::imdecode takes a Mat header over the bytes; it does not modify them.
-  const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
-                        const_cast<char*>(bytes.data()));
-  cv::Mat decoded;
-  try {
-    decoded = cv::imdecode(encoded, cv::IMREAD_COLOR);
-  } catch (const cv::Exception& e) {
-    return Status::InvalidArgument(std::string("image: decoder failed: ") + e.what());
-  }
-  if (decoded.empty() || decoded.type() != CV_8UC3) {
-    return Status::InvalidArgument("image: could not decode " + std::to_string(bytes.size()) +
-                                   " bytes as JPEG/PNG (corrupt or truncated)");
-  }
-  return cv::Mat3b(decoded);
+  // The decoders check their own header against the pixel limit again before allocating, so
+  // nothing this function accepted can decode to more pixels than the limit allows.
+  return header->format == ImageFormat::kJpeg ? DecodeJpegStrict(bytes, limits.max_pixels)
+                                              : DecodePngStrict(bytes, limits.max_pixels);
 }
 
 Result<std::string> EncodeProbabilityPng(const cv::Mat1f& probability) {

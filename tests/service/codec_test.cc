@@ -1,8 +1,11 @@
 // Image header peeking and decoding limits.
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "server/core/image_codec.h"
 #include "server/core/image_header.h"
+#include "server/core/strict_decoders.h"
 #include "tests/service/test_images.h"
 
 namespace tod::server {
@@ -63,6 +66,72 @@ TEST(ImageCodecTest, GreyPngBecomesBgr) {
   const Result<cv::Mat3b> decoded = DecodeImage(testing::Encode(grey, ".png"), ImageLimits{});
   ASSERT_TRUE(decoded.ok());
   EXPECT_EQ((*decoded)(3, 4), cv::Vec3b(77, 77, 77));
+}
+
+// A frame with texture, so that its JPEG has substantial entropy-coded data.
+cv::Mat3b Textured(int width, int height) {
+  cv::Mat3b frame(height, width);
+  cv::RNG rng(11);
+  rng.fill(frame, cv::RNG::UNIFORM, 0, 255);
+  return frame;
+}
+
+TEST(StrictDecoderTest, DecodesJpegAndPngLikeOpenCv) {
+  const cv::Mat3b frame = Textured(97, 41);
+  for (const std::string ext : {".jpg", ".png"}) {
+    const std::string bytes = testing::Encode(frame, ext);
+    const Result<cv::Mat3b> ours = DecodeImage(bytes, ImageLimits{});
+    ASSERT_TRUE(ours.ok()) << ext << ": " << ours.status().message();
+    const cv::Mat reference =
+        cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_COLOR);
+    // Same library underneath; JPEG may differ by the IDCT/upsampling choice by a level or two.
+    EXPECT_LE(cv::norm(*ours, reference, cv::NORM_INF), ext == ".png" ? 0 : 8) << ext;
+  }
+  // Greyscale, progressive, 16-bit and alpha inputs all come out as 8-bit BGR.
+  const cv::Mat1b grey(9, 7, uchar{90});
+  EXPECT_TRUE(DecodeImage(testing::Encode(grey, ".jpg"), ImageLimits{}).ok());
+  std::vector<uchar> progressive;
+  cv::imencode(".jpg", frame, progressive, {cv::IMWRITE_JPEG_PROGRESSIVE, 1});
+  EXPECT_TRUE(DecodeImage(std::string(progressive.begin(), progressive.end()), ImageLimits{}).ok());
+  cv::Mat deep;
+  frame.convertTo(deep, CV_16UC3, 256);
+  const Result<cv::Mat3b> from_deep = DecodeImage(testing::Encode(deep, ".png"), ImageLimits{});
+  ASSERT_TRUE(from_deep.ok()) << from_deep.status().message();
+  EXPECT_EQ((*from_deep)(3, 3), frame(3, 3));
+  cv::Mat alpha;
+  cv::cvtColor(frame, alpha, cv::COLOR_BGR2BGRA);
+  EXPECT_TRUE(DecodeImage(testing::Encode(alpha, ".png"), ImageLimits{}).ok());
+}
+
+TEST(StrictDecoderTest, DecoderWarningsAreErrors) {
+  const std::string jpeg = testing::Encode(Textured(160, 96), ".jpg");
+  std::string zeroed = jpeg;
+  std::fill(zeroed.begin() + static_cast<long>(zeroed.size() / 2), zeroed.end(), '\0');
+  std::string garbled = jpeg;
+  for (size_t i = garbled.size() / 3; i < garbled.size() / 3 + 40; ++i) garbled[i] = '\xff';
+  for (const std::string& bad : {jpeg.substr(0, jpeg.size() * 2 / 3), zeroed, garbled}) {
+    const Status status = DecodeImage(bad, ImageLimits{}).status();
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << status.message();
+    EXPECT_NE(status.message().find("cannot decode JPEG"), std::string::npos) << status.message();
+  }
+  const std::string png = testing::Encode(Textured(160, 96), ".png");
+  std::string flipped = png;
+  flipped[png.size() / 2] = static_cast<char>(flipped[png.size() / 2] ^ 0x55);  // CRC mismatch
+  for (const std::string& bad : {png.substr(0, png.size() - 1), flipped}) {
+    const Status status = DecodeImage(bad, ImageLimits{}).status();
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << status.message();
+  }
+}
+
+TEST(StrictDecoderTest, PixelLimitIsCheckedOnTheDecodersOwnHeader) {
+  // The decoders refuse by the size their own header parser reads, independently of the
+  // admission-time peek (a second guard, before any pixel memory is allocated).
+  const std::string jpeg = testing::Encode(Textured(64, 32), ".jpg");
+  const std::string png = testing::Encode(Textured(64, 32), ".png");
+  EXPECT_EQ(DecodeJpegStrict(jpeg, 64 * 32 - 1).status().code(), StatusCode::kResourceExhausted);
+  EXPECT_EQ(DecodePngStrict(png, 64 * 32 - 1).status().code(), StatusCode::kResourceExhausted);
+  EXPECT_TRUE(DecodeJpegStrict(jpeg, 64 * 32).ok());
+  EXPECT_TRUE(DecodePngStrict(png, 64 * 32).ok());
 }
 
 TEST(ImageCodecTest, ProbabilityPngIsScaledAndClamped) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <vector>
 
 namespace tod::server {
 namespace {
@@ -99,6 +100,47 @@ TEST(ConfigTest, EverySettingHasAFlagAnEnvironmentVariableAndAJsonKey) {
                          spec.key != "log_level";
     EXPECT_TRUE(ApplySetting(spec.key, numeric ? "5" : "text", "test", &config).ok()) << spec.key;
     EXPECT_TRUE(ServerConfigToJson(config).contains(spec.key)) << spec.key;
+  }
+}
+
+TEST(ConfigTest, HttpLimitsComeFromEverySourceAndAreRangeChecked) {
+  const Result<ServerConfig> defaults = ResolveServerConfig({{"model", "/m"}}, FakeEnv({}));
+  ASSERT_TRUE(defaults.ok());
+  EXPECT_EQ(defaults->max_image_pixels, 4'000'000);
+  EXPECT_EQ(defaults->http_max_header_bytes, 16u * 1024);
+  EXPECT_EQ(defaults->http_max_connections_per_client, 64);
+
+  const std::string file =
+      WriteTempFile("tod_config_http.json", R"({"model": "/m", "http_max_connections": 100,
+          "http_write_timeout_s": 7})");
+  const Result<ServerConfig> config = ResolveServerConfig(
+      {{"config", file}, {"http_idle_timeout_s", "5"}},
+      FakeEnv({{"TOD_HTTP_REQUEST_TIMEOUT", "2.5"}, {"TOD_HTTP_MAX_HEADER_BYTES", "4096"}}));
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config->http_max_connections, 100);     // file
+  EXPECT_EQ(config->http_write_timeout_s, 7);       // file
+  EXPECT_EQ(config->http_request_timeout_s, 2.5);   // environment
+  EXPECT_EQ(config->http_max_header_bytes, 4096u);  // environment
+  EXPECT_EQ(config->http_idle_timeout_s, 5);        // flag
+  std::remove(file.c_str());
+
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"http_request_timeout_s", "nan"},
+      {"http_request_timeout_s", "0"},
+      {"http_idle_timeout_s", "inf"},
+      {"http_max_connections", "0"},
+      {"http_max_connections_per_client", "600"},  // more than http_max_connections
+      {"http_max_header_bytes", "100"},
+      {"http_max_buffered_bytes", "1000"},
+      {"drain_timeout_s", "1e300"},
+      {"http_threads", "1000"},
+  };
+  for (const auto& [key, value] : bad) {
+    const Result<ServerConfig> refused =
+        ResolveServerConfig({{"model", "/m"}, {key, value}}, FakeEnv({}));
+    ASSERT_FALSE(refused.ok()) << key << "=" << value;
+    EXPECT_NE(refused.status().message().find(key), std::string::npos)
+        << refused.status().message();
   }
 }
 

@@ -47,6 +47,7 @@ class ServerProcess {
   std::optional<int> WaitExit(std::chrono::milliseconds timeout);
   std::string Log() const;
 
+  pid_t pid() const { return pid_; }
   int grpc_port() const { return grpc_port_; }
   int http_port() const { return http_port_; }
   std::string grpc_address() const { return "127.0.0.1:" + std::to_string(grpc_port_); }
