@@ -20,6 +20,9 @@ RequestOptions OptionsFromProto(const tod::v1::DetectOptions& options) {
   if (options.has_obstacle_threshold()) {
     out.detect.obstacle_threshold = options.obstacle_threshold();
   }
+  if (options.has_min_obstacle_score()) {
+    out.detect.min_obstacle_score = options.min_obstacle_score();
+  }
   out.encode_map_png = options.map_format() != tod::v1::MAP_FORMAT_NONE;
   out.detect.want_probability_map = out.encode_map_png;
   return out;
@@ -38,6 +41,8 @@ void FillDetectResponse(const InferenceResult& result, const std::string& frame_
     out->set_area(static_cast<int32_t>(obstacle.area));
     out->set_peak_probability(obstacle.peak_probability);
     out->set_mean_probability(obstacle.mean_probability);
+    out->set_score(obstacle.score);
+    out->set_evidence(obstacle.evidence);
   }
   for (const Proposal& proposal : detection.proposals) {
     tod::v1::Proposal* out = response->add_proposals();

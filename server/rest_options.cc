@@ -55,6 +55,10 @@ Status ParseDetectQuery(const QueryParams& query, InferenceRequest* inference,
   if (!threshold.ok()) return threshold.status();
   if (*threshold) inference->options.obstacle_threshold = static_cast<float>(**threshold);
 
+  const Result<std::optional<double>> min_score = RealParam(query, "min_obstacle_score", 0, 1);
+  if (!min_score.ok()) return min_score.status();
+  if (*min_score) inference->options.min_obstacle_score = static_cast<float>(**min_score);
+
   if (const auto map = query.find("map"); map != query.end()) {
     if (map->second == "none") {
       inference->encode_map_png = false;

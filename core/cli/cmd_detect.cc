@@ -26,6 +26,9 @@ Runner AddDetectCommand(CLI::App& app) {
   cmd->add_option("--model", args->model, "model bundle directory")->required();
   cmd->add_option("--out", args->out, "output directory")->required();
   cmd->add_option("images", args->images, "image files (PNG, JPEG)")->required();
+  cmd->add_option("--min-obstacle-score", args->options.min_obstacle_score,
+                  "report only obstacles whose calibrated score reaches this")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--threshold", args->options.obstacle_threshold, "obstacle threshold on the map")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--max-proposals", args->options.max_proposals, "proposals listed in the JSON")

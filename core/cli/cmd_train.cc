@@ -20,6 +20,7 @@ Runner AddTrainCommand(CLI::App& app) {
     std::string eval_split = "test";
     int eval_frames = 0;
     int trees = 200;
+    std::string on_bad_frame = "fail";
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("train", "train a model bundle from a dataset's train split");
@@ -44,6 +45,9 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--trees", args->trees, "trees per regressor (paper: 200)")
       ->check(CLI::Range(1, 2000));
   cmd->add_option("--threads", args->train.threads, "worker threads (0 = all cores)");
+  cmd->add_option("--on-bad-frame", args->on_bad_frame,
+                  "fail: stop at an unreadable frame; skip: leave it out, list and count it")
+      ->check(CLI::IsMember({"fail", "skip"}));
   cmd->add_flag("--no-size-filter", args->no_size_filter, "switch the box size filter off");
   bool* correct = &args->train.prior_correction;
   cmd->add_flag_callback(
@@ -61,6 +65,7 @@ Runner AddTrainCommand(CLI::App& app) {
                   "evaluate on at most this many frames (0 = all)");
   return [args] {
     TrainOptions options = args->train;
+    options.on_bad_frame = *ParseBadFramePolicy(args->on_bad_frame);  // checked by CLI11
     if (!options.sed_model.empty() && options.edge_source != "sed") options.edge_source = "sed";
     options.regressor.num_trees = args->trees;
     options.params.size_filter = !args->no_size_filter;
@@ -79,6 +84,7 @@ Runner AddTrainCommand(CLI::App& app) {
     eval.data_root = options.data_root;
     eval.format = options.format;
     eval.split_file = options.split_file;
+    eval.on_bad_frame = options.on_bad_frame;
     eval.split = args->eval_split;
     eval.max_frames = args->eval_frames;
     eval.threads = options.threads;

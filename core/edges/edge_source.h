@@ -54,6 +54,20 @@ struct EdgeTrainingFrame {
   cv::Mat1i labels;  // same size: -1 ignore, 0 background, 1 road, >= 2 obstacle instance
 };
 
+// Balanced training samples of the pixel edge classifier, with what was available to sample from
+// (for the prior correction).
+struct EdgeSamples {
+  cv::Mat1f features;
+  std::vector<float> targets;
+  double positive_cells = 0;  // boundary cells available in the frames that gave samples
+  double negative_cells = 0;
+};
+// The samples of one training frame (seeded by frame_index); none when the frame has no boundary
+// or no non-boundary cell outside void.
+Result<EdgeSamples> ExtractEdgeSamples(const EdgeTrainingFrame& frame,
+                                       const PixelEdgeParams& params, std::size_t frame_index);
+void AppendEdgeSamples(EdgeSamples& into, const EdgeSamples& more);
+
 class PixelEdgeClassifier : public EdgeSource {
  public:
   // Untrained: Compute() gives an all-zero map.
@@ -62,9 +76,10 @@ class PixelEdgeClassifier : public EdgeSource {
   // frames hold no boundary (or no non-boundary) sample.
   static Result<PixelEdgeClassifier> TryTrain(const std::vector<EdgeTrainingFrame>& frames,
                                               const PixelEdgeParams& params);
-  // TryTrain, returning an untrained classifier on failure (check trained()).
-  static PixelEdgeClassifier Train(const std::vector<EdgeTrainingFrame>& frames,
-                                   const PixelEdgeParams& params);
+  // The same from samples extracted frame by frame (ExtractEdgeSamples), so a trainer never has
+  // to hold the frames themselves.
+  static Result<PixelEdgeClassifier> TrainOnSamples(const EdgeSamples& samples,
+                                                    const PixelEdgeParams& params);
   bool trained() const { return !forest_.empty(); }
   cv::Mat1f Compute(const cv::Mat3b& bgr) const override;
   std::string kind() const override { return "pixel_forest"; }

@@ -70,75 +70,88 @@ Status CheckFrame(const EdgeTrainingFrame& frame, std::size_t index) {
 
 }  // namespace
 
-Result<PixelEdgeClassifier> PixelEdgeClassifier::TryTrain(
-    const std::vector<EdgeTrainingFrame>& frames, const PixelEdgeParams& params) {
-  if (frames.empty()) return Status::InvalidArgument("pixel edge training: no frames");
+Result<EdgeSamples> ExtractEdgeSamples(const EdgeTrainingFrame& frame,
+                                       const PixelEdgeParams& params, std::size_t frame_index) {
   if (params.samples_per_frame < 2) {
     return Status::InvalidArgument("pixel edge training: samples_per_frame must be >= 2");
   }
-  for (std::size_t f = 0; f < frames.size(); ++f) {
-    if (Status status = CheckFrame(frames[f], f); !status.ok()) return status;
-  }
+  if (Status status = CheckFrame(frame, frame_index); !status.ok()) return status;
   const int num_features = NumPixelFeatures();
   const std::size_t per_class = static_cast<std::size_t>(params.samples_per_frame / 2);
-  cv::Mat1f features(0, num_features);
-  std::vector<float> targets;
-  std::size_t positives = 0;
-  double positive_cells_available = 0, negative_cells_available = 0;
-  for (std::size_t f = 0; f < frames.size(); ++f) {
-    const EdgeTrainingFrame& frame = frames[f];
-    const CellLabels cells = ComputeCellLabels(frame.labels, params.boundary_radius);
-    std::vector<int> positive_cells;
-    std::vector<int> negative_cells;
-    for (int i = 0; i < cells.near_fraction.rows; ++i) {
-      for (int j = 0; j < cells.near_fraction.cols; ++j) {
-        if (cells.void_fraction(i, j) > params.max_void_fraction) continue;
-        const int index = i * cells.near_fraction.cols + j;
-        (cells.near_fraction(i, j) >= kPositiveNearFraction ? positive_cells : negative_cells)
-            .push_back(index);
-      }
+  EdgeSamples out;
+  out.features.create(0, num_features);
+  const CellLabels cells = ComputeCellLabels(frame.labels, params.boundary_radius);
+  std::vector<int> positive_cells;
+  std::vector<int> negative_cells;
+  for (int i = 0; i < cells.near_fraction.rows; ++i) {
+    for (int j = 0; j < cells.near_fraction.cols; ++j) {
+      if (cells.void_fraction(i, j) > params.max_void_fraction) continue;
+      const int index = i * cells.near_fraction.cols + j;
+      (cells.near_fraction(i, j) >= kPositiveNearFraction ? positive_cells : negative_cells)
+          .push_back(index);
     }
-    // Same number of each class from every frame, so the forest's mean is a balanced probability.
-    const std::size_t count = std::min({per_class, positive_cells.size(), negative_cells.size()});
-    if (count == 0) continue;
-    positive_cells_available += static_cast<double>(positive_cells.size());
-    negative_cells_available += static_cast<double>(negative_cells.size());
-    std::mt19937_64 rng(params.forest.seed * 0x9E3779B97F4A7C15ULL + f);
-    const EdgeChannels channels = ComputeEdgeChannels(frame.image, params.channels);
-    const PixelFeatureExtractor extractor(channels);
-    const int cols = channels.cols();
-    const auto add_samples = [&](std::vector<int> pool, float target) {
-      for (const int index : SampleWithoutReplacement(std::move(pool), count, rng)) {
-        cv::Mat1f row(1, num_features);
-        extractor.Extract(index / cols, index % cols, row.ptr<float>(0));
-        features.push_back(row);
-        targets.push_back(target);
-      }
-    };
-    add_samples(std::move(positive_cells), 1.f);
-    add_samples(std::move(negative_cells), 0.f);
-    positives += count;
   }
-  if (positives == 0) {
+  // Same number of each class from every frame, so the forest's mean is a balanced probability.
+  const std::size_t count = std::min({per_class, positive_cells.size(), negative_cells.size()});
+  if (count == 0) return out;
+  out.positive_cells = static_cast<double>(positive_cells.size());
+  out.negative_cells = static_cast<double>(negative_cells.size());
+  std::mt19937_64 rng(params.forest.seed * 0x9E3779B97F4A7C15ULL + frame_index);
+  const EdgeChannels channels = ComputeEdgeChannels(frame.image, params.channels);
+  const PixelFeatureExtractor extractor(channels);
+  const int cols = channels.cols();
+  const auto add_samples = [&](std::vector<int> pool, float target) {
+    for (const int index : SampleWithoutReplacement(std::move(pool), count, rng)) {
+      cv::Mat1f row(1, num_features);
+      extractor.Extract(index / cols, index % cols, row.ptr<float>(0));
+      out.features.push_back(row);
+      out.targets.push_back(target);
+    }
+  };
+  add_samples(std::move(positive_cells), 1.f);
+  add_samples(std::move(negative_cells), 0.f);
+  return out;
+}
+
+void AppendEdgeSamples(EdgeSamples& into, const EdgeSamples& more) {
+  if (more.targets.empty()) return;
+  if (into.features.empty()) into.features.create(0, more.features.cols);
+  into.features.push_back(more.features);
+  into.targets.insert(into.targets.end(), more.targets.begin(), more.targets.end());
+  into.positive_cells += more.positive_cells;
+  into.negative_cells += more.negative_cells;
+}
+
+Result<PixelEdgeClassifier> PixelEdgeClassifier::TrainOnSamples(const EdgeSamples& samples,
+                                                                const PixelEdgeParams& params) {
+  if (samples.targets.empty() || samples.negative_cells <= 0) {
     return Status::InvalidArgument(
         "pixel edge training: no frame has both boundary and non-boundary pixels outside void");
   }
   PixelEdgeClassifier classifier;
-  classifier.forest_ = RandomForest::Train(features, targets, params.forest);
+  Result<RandomForest> forest = RandomForest::Fit(samples.features, samples.targets, params.forest);
+  if (!forest.ok()) return forest.status().WithContext("pixel edge training");
+  classifier.forest_ = std::move(forest).value();
   classifier.channel_params_ = params.channels;
   // Equal counts per class from every frame: negatives were kept at count / negatives available,
   // positives at count / positives available, so the odds factor is the ratio of availabilities.
-  classifier.sampled_odds_scale_ = positive_cells_available / negative_cells_available;
+  classifier.sampled_odds_scale_ = samples.positive_cells / samples.negative_cells;
   if (classifier.forest_.empty()) {
     return Status::Internal("pixel edge training: the forest trainer returned no trees");
   }
   return classifier;
 }
 
-PixelEdgeClassifier PixelEdgeClassifier::Train(const std::vector<EdgeTrainingFrame>& frames,
-                                               const PixelEdgeParams& params) {
-  Result<PixelEdgeClassifier> trained = TryTrain(frames, params);
-  return trained.ok() ? std::move(trained).value() : PixelEdgeClassifier();
+Result<PixelEdgeClassifier> PixelEdgeClassifier::TryTrain(
+    const std::vector<EdgeTrainingFrame>& frames, const PixelEdgeParams& params) {
+  if (frames.empty()) return Status::InvalidArgument("pixel edge training: no frames");
+  EdgeSamples all;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    Result<EdgeSamples> samples = ExtractEdgeSamples(frames[f], params, f);
+    if (!samples.ok()) return samples.status();
+    AppendEdgeSamples(all, *samples);
+  }
+  return TrainOnSamples(all, params);
 }
 
 cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr) const {

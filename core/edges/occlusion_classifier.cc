@@ -125,84 +125,110 @@ Status ReadValue(std::istream& in, T& value, const std::string& what, const char
 
 }  // namespace
 
-Result<OcclusionClassifier> OcclusionClassifier::Fit(
-    const std::vector<OcclusionTrainingFrame>& frames, const OcclusionParams& params) {
+namespace {
+
+Status ValidateOcclusionParams(const OcclusionParams& params) {
   if (!(params.floor >= 0.f && params.floor <= 1.f)) {
     return Status::InvalidArgument("occlusion params.floor must be in [0,1]");
   }
   if (!(params.max_void_fraction >= 0.0 && params.max_void_fraction <= 1.0)) {
     return Status::InvalidArgument("occlusion params.max_void_fraction must be in [0,1]");
   }
-  std::vector<float> positive_rows;  // flattened feature rows
-  std::vector<float> positive_targets;
-  std::vector<float> negative_rows;
-  for (size_t i = 0; i < frames.size(); ++i) {
-    const OcclusionTrainingFrame& frame = frames[i];
-    const std::string what = "occlusion training frame " + std::to_string(i);
-    if (Status s = ValidateMaps(frame.image, frame.enhanced_edge, frame.superpixels, what);
-        !s.ok()) {
-      return s;
-    }
-    if (frame.labels.size() != frame.image.size()) {
-      return Status::InvalidArgument(what + ": labels size differs from the image size");
-    }
-    const SuperpixelPairs pairs =
-        ComputeSuperpixelPairs(frame.image, frame.enhanced_edge, frame.superpixels);
-    const std::vector<RegionTruth> truths =
-        RegionTruths(frame.superpixels.labels, frame.superpixels.count, frame.labels);
-    for (size_t p = 0; p < pairs.pairs.size(); ++p) {
-      const RegionTruth& a = truths[pairs.pairs[p][0]];
-      const RegionTruth& b = truths[pairs.pairs[p][1]];
-      if (a.majority < 0 || b.majority < 0 || a.void_fraction > params.max_void_fraction ||
-          b.void_fraction > params.max_void_fraction) {
-        continue;
-      }
-      const float* row = pairs.features[static_cast<int>(p)];
-      if (a.majority == b.majority) {
-        negative_rows.insert(negative_rows.end(), row, row + kNumOcclusionFeatures);
-        continue;
-      }
-      // An obstacle's contour is an occlusion boundary; road against background is a real but
-      // non-obstacle boundary, kept at half strength (§3.4 step 4, the 0.5 option).
-      const bool obstacle_side = std::max(a.majority, b.majority) >= 2;
-      positive_rows.insert(positive_rows.end(), row, row + kNumOcclusionFeatures);
-      positive_targets.push_back(obstacle_side ? 1.f : 0.5f);
-    }
+  return Status::Ok();
+}
+
+// Keeps a seeded random subset of `count` rows of `rows` (row-major, kNumOcclusionFeatures wide).
+void KeepRandomRows(std::vector<float>& rows, std::size_t count, std::uint64_t seed) {
+  const std::size_t total = rows.size() / kNumOcclusionFeatures;
+  if (count >= total) return;
+  std::vector<std::size_t> order(total);
+  for (std::size_t i = 0; i < total; ++i) order[i] = i;
+  std::mt19937_64 rng(seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  order.resize(count);
+  std::sort(order.begin(), order.end());
+  std::vector<float> kept(count * kNumOcclusionFeatures);
+  for (std::size_t i = 0; i < count; ++i)
+    std::copy_n(rows.data() + order[i] * kNumOcclusionFeatures, kNumOcclusionFeatures,
+                kept.data() + i * kNumOcclusionFeatures);
+  rows.swap(kept);
+}
+
+}  // namespace
+
+Result<OcclusionSamples> ExtractOcclusionSamples(const OcclusionTrainingFrame& frame,
+                                                 const OcclusionParams& params,
+                                                 std::size_t frame_index) {
+  if (Status s = ValidateOcclusionParams(params); !s.ok()) return s;
+  const std::string what = "occlusion training frame " + std::to_string(frame_index);
+  if (Status s = ValidateMaps(frame.image, frame.enhanced_edge, frame.superpixels, what); !s.ok()) {
+    return s;
   }
-  const size_t num_positive = positive_targets.size();
-  size_t num_negative = negative_rows.size() / kNumOcclusionFeatures;
-  if (num_positive + num_negative == 0) {
-    return Status::InvalidArgument("occlusion training: no usable superpixel pair in " +
-                                   std::to_string(frames.size()) + " frames");
+  if (frame.labels.size() != frame.image.size()) {
+    return Status::InvalidArgument(what + ": labels size differs from the image size");
+  }
+  const SuperpixelPairs pairs =
+      ComputeSuperpixelPairs(frame.image, frame.enhanced_edge, frame.superpixels);
+  const std::vector<RegionTruth> truths =
+      RegionTruths(frame.superpixels.labels, frame.superpixels.count, frame.labels);
+  OcclusionSamples out;
+  for (size_t p = 0; p < pairs.pairs.size(); ++p) {
+    const RegionTruth& a = truths[pairs.pairs[p][0]];
+    const RegionTruth& b = truths[pairs.pairs[p][1]];
+    if (a.majority < 0 || b.majority < 0 || a.void_fraction > params.max_void_fraction ||
+        b.void_fraction > params.max_void_fraction) {
+      continue;
+    }
+    const float* row = pairs.features[static_cast<int>(p)];
+    if (a.majority == b.majority) {
+      out.negative_rows.insert(out.negative_rows.end(), row, row + kNumOcclusionFeatures);
+      continue;
+    }
+    // An obstacle's contour is an occlusion boundary; road against background is a real but
+    // non-obstacle boundary, kept at half strength (§3.4 step 4, the 0.5 option).
+    const bool obstacle_side = std::max(a.majority, b.majority) >= 2;
+    out.positive_rows.insert(out.positive_rows.end(), row, row + kNumOcclusionFeatures);
+    out.positive_targets.push_back(obstacle_side ? 1.f : 0.5f);
+  }
+  // A frame keeps at most kNegativesPerPositive negatives per positive (at least a few hundred),
+  // so that a trainer streaming a thousand frames holds samples, not every pair of every frame.
+  const std::size_t available = out.negative_rows.size() / kNumOcclusionFeatures;
+  const std::size_t cap =
+      std::max<std::size_t>(kNegativesPerPositive * out.positive_targets.size(), 256);
+  KeepRandomRows(out.negative_rows, std::min(available, cap),
+                 params.forest.seed * 0x9E3779B97F4A7C15ULL + frame_index);
+  out.negatives_available = static_cast<double>(available);
+  return out;
+}
+
+void AppendOcclusionSamples(OcclusionSamples& into, const OcclusionSamples& more) {
+  into.positive_rows.insert(into.positive_rows.end(), more.positive_rows.begin(),
+                            more.positive_rows.end());
+  into.positive_targets.insert(into.positive_targets.end(), more.positive_targets.begin(),
+                               more.positive_targets.end());
+  into.negative_rows.insert(into.negative_rows.end(), more.negative_rows.begin(),
+                            more.negative_rows.end());
+  into.negatives_available += more.negatives_available;
+}
+
+Result<OcclusionClassifier> OcclusionClassifier::FitOnSamples(OcclusionSamples samples,
+                                                              const OcclusionParams& params) {
+  if (Status s = ValidateOcclusionParams(params); !s.ok()) return s;
+  const size_t num_positive = samples.positive_targets.size();
+  if (num_positive == 0) {
+    return Status::InvalidArgument(
+        "occlusion training: no obstacle contour among the superpixel pairs (are there obstacles "
+        "in the training frames?)");
   }
   // Balance: all positives, at most kNegativesPerPositive negatives each (a seeded subset).
-  std::vector<size_t> negative_order(num_negative);
-  for (size_t i = 0; i < num_negative; ++i) negative_order[i] = i;
-  const size_t keep_negative = num_positive == 0
-                                   ? num_negative
-                                   : std::min(num_negative, kNegativesPerPositive * num_positive);
-  if (keep_negative < num_negative) {
-    std::mt19937_64 rng(params.forest.seed);
-    std::shuffle(negative_order.begin(), negative_order.end(), rng);
-    negative_order.resize(keep_negative);
-    std::sort(negative_order.begin(), negative_order.end());
-  }
-  const double negative_share_kept =
-      num_negative > 0 ? static_cast<double>(negative_order.size()) / num_negative : 1.0;
-  num_negative = negative_order.size();
+  KeepRandomRows(samples.negative_rows, kNegativesPerPositive * num_positive, params.forest.seed);
+  const size_t num_negative = samples.negative_rows.size() / kNumOcclusionFeatures;
   cv::Mat1f features(static_cast<int>(num_positive + num_negative), kNumOcclusionFeatures);
-  std::vector<float> targets;
-  targets.reserve(num_positive + num_negative);
-  for (size_t i = 0; i < num_positive; ++i) {
-    std::copy_n(positive_rows.data() + i * kNumOcclusionFeatures, kNumOcclusionFeatures,
-                features[static_cast<int>(i)]);
-    targets.push_back(positive_targets[i]);
-  }
-  for (size_t i = 0; i < num_negative; ++i) {
-    std::copy_n(negative_rows.data() + negative_order[i] * kNumOcclusionFeatures,
-                kNumOcclusionFeatures, features[static_cast<int>(num_positive + i)]);
-    targets.push_back(0.f);
-  }
+  std::copy(samples.positive_rows.begin(), samples.positive_rows.end(), features[0]);
+  std::copy(samples.negative_rows.begin(), samples.negative_rows.end(),
+            features[static_cast<int>(num_positive)]);
+  std::vector<float> targets = samples.positive_targets;
+  targets.resize(num_positive + num_negative, 0.f);
   Result<RandomForest> forest = RandomForest::Fit(features, targets, params.forest);
   if (!forest.ok()) {
     return Status::InvalidArgument("occlusion training: " + forest.status().message());
@@ -210,19 +236,22 @@ Result<OcclusionClassifier> OcclusionClassifier::Fit(
   OcclusionClassifier classifier;
   classifier.params_ = params;
   classifier.forest_ = std::move(forest).value();
-  classifier.sampled_odds_scale_ = negative_share_kept;  // every positive pair is kept
+  // Every positive pair is kept, negatives at (kept / available).
+  classifier.sampled_odds_scale_ =
+      samples.negatives_available > 0 ? num_negative / samples.negatives_available : 1.0;
   return classifier;
 }
 
-OcclusionClassifier OcclusionClassifier::Train(const std::vector<OcclusionTrainingFrame>& frames,
-                                               const OcclusionParams& params) {
-  Result<OcclusionClassifier> result = Fit(frames, params);
-  if (!result.ok()) {
-    OcclusionClassifier untrained;
-    untrained.params_ = params;
-    return untrained;
+Result<OcclusionClassifier> OcclusionClassifier::Fit(
+    const std::vector<OcclusionTrainingFrame>& frames, const OcclusionParams& params) {
+  OcclusionSamples all;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    Result<OcclusionSamples> samples = ExtractOcclusionSamples(frames[i], params, i);
+    if (!samples.ok()) return samples.status();
+    AppendOcclusionSamples(all, *samples);
   }
-  return std::move(result).value();
+  if (frames.empty()) return Status::InvalidArgument("occlusion training: no frames");
+  return FitOnSamples(std::move(all), params);
 }
 
 Result<cv::Mat1f> OcclusionClassifier::PaintChecked(const cv::Mat3b& image,

@@ -28,17 +28,31 @@ struct OcclusionTrainingFrame {
   cv::Mat1i labels;  // -1 ignore, 0 background, 1 road, >= 2 obstacle instance
 };
 
+// Training pairs of one or more frames (rows of kNumOcclusionFeatures floats), with the number of
+// negative pairs there were before subsampling (for the prior correction).
+struct OcclusionSamples {
+  std::vector<float> positive_rows;
+  std::vector<float> positive_targets;  // 1 obstacle contour, 0.5 road against background
+  std::vector<float> negative_rows;
+  double negatives_available = 0;
+};
+// The pairs of one frame; negatives are subsampled per frame (seeded by frame_index).
+Result<OcclusionSamples> ExtractOcclusionSamples(const OcclusionTrainingFrame& frame,
+                                                 const OcclusionParams& params,
+                                                 std::size_t frame_index);
+void AppendOcclusionSamples(OcclusionSamples& into, const OcclusionSamples& more);
+
 class OcclusionClassifier {
  public:
-  // Untrained: mean-Ê boundary strength (fallback).
+  // Untrained: mean-Ê boundary strength (the §3.4 fallback; a bundle never ships one untrained).
   OcclusionClassifier() = default;
-  // Invalid input (a frame whose maps disagree in size, no usable pair, bad params) gives an
-  // untrained classifier; use Fit to learn why.
-  static OcclusionClassifier Train(const std::vector<OcclusionTrainingFrame>& frames,
-                                   const OcclusionParams& params);
-  // As Train, reporting invalid input as a Status naming the frame and field.
+  // Trains on the frames; invalid input (a frame whose maps disagree in size, no obstacle
+  // contour, bad params) is a Status naming the frame and field.
   static Result<OcclusionClassifier> Fit(const std::vector<OcclusionTrainingFrame>& frames,
                                          const OcclusionParams& params);
+  // The same from samples extracted frame by frame (ExtractOcclusionSamples).
+  static Result<OcclusionClassifier> FitOnSamples(OcclusionSamples samples,
+                                                  const OcclusionParams& params);
   bool trained() const { return !forest_.empty(); }
   const OcclusionParams& params() const { return params_; }
   // Of the last Fit: (share of negative pairs kept) / (share of positive pairs kept), the odds

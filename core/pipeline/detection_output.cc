@@ -32,6 +32,8 @@ nlohmann::json DetectionToJson(const Detection& d, const std::string& image_name
                               {"h", o.box.h},
                               {"area", o.area},
                               {"peak", o.peak_probability},
+                              {"score", o.score},
+                              {"evidence", o.evidence},
                               {"mean", o.mean_probability}});
   nlohmann::json timing = nlohmann::json::object();
   double total = 0;

@@ -17,6 +17,9 @@ namespace tod {
 struct DetectOptions {
   int max_proposals = 100;          // proposals returned (the map always uses all of them)
   float obstacle_threshold = 0.5f;  // obstacle mask = P > threshold
+  // Components whose calibrated score (DetectedObstacle::score) is below this are not reported:
+  // an empty road reports no obstacle.
+  float min_obstacle_score = 0.5f;
   bool want_probability_map = true;
 };
 
@@ -32,6 +35,9 @@ struct DetectedObstacle {
   long long area = 0;  // pixels of the connected component
   float peak_probability = 0.f;
   float mean_probability = 0.f;
+  float evidence = 0.f;  // largest fused score F of the map's boxes overlapping it
+  float score = 0.f;     // calibrated probability that it is an obstacle (= evidence if the
+                         // bundle has no calibration)
 };
 
 struct Detection {

@@ -78,6 +78,8 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   for (const auto& v : RegressionVariants())
     served_map_histograms.emplace(v, PixelHistogramAccumulator());
   std::map<std::string, std::vector<double>> stage_ms;
+  ReportedObstacleCounts alarms;
+  bool road_labelled = false, not_obstacle = false;
   std::vector<std::string> stage_order;
   std::mutex mutex;
   int done = 0;
@@ -143,9 +145,30 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
         AccumulateProbabilityMap(op_ordr, s.image.size(), bundle.params.probability_map);
     const float min_score = bundle.params.probability_map.min_score;
 
+    // Reported obstacles at the detector's defaults (calibrated score >= 0.5).
+    const std::vector<DetectedObstacle> reported =
+        ScoreObstacles(map_fusion, bp_fusion, bundle.params, DetectOptions{});
+    int false_alarms = 0;
+    for (const DetectedObstacle& o : reported)
+      false_alarms += cv::countNonZero(s.obstacle(o.box.rect())) == 0;
+    int found = 0;
+    for (const ObstacleInstance& inst : s.instances)
+      for (const DetectedObstacle& o : reported)
+        if (!Intersect(o.box, inst.box).empty()) {
+          ++found;
+          break;
+        }
+
     std::vector<Box> gt;
     for (const auto& inst : s.instances) gt.push_back(inst.box);
     std::lock_guard lock(mutex);
+    alarms.false_alarms += false_alarms;
+    (s.free_space == FreeSpace::kRoadLabel ? road_labelled : not_obstacle) = true;
+    alarms.instances_found += found;
+    if (s.instances.empty()) {
+      ++alarms.obstacle_free_frames;
+      alarms.false_alarms_on_obstacle_free += false_alarms;
+    }
     recall.at("EB").Add(eb, gt);
     recall.at("OLP@1").Add(BoxesOf(olp1.boxes), gt);
     recall.at("OAOCC+OLP@1").Add(oaocc1, gt);
@@ -177,6 +200,13 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   if (!bad.ok()) return bad;
   report.frames = n - static_cast<int>(report.skipped.size());
   report.instances = recall.at("EB").instances();
+  report.reported = alarms;
+  report.free_space = road_labelled && not_obstacle
+                          ? "mixed: the road label where the frame has one, else every non-void "
+                            "non-obstacle pixel"
+                      : not_obstacle
+                          ? "every non-void pixel that is not an obstacle (no road label)"
+                          : "the road label (free space)";
   for (const auto& v : ProposalVariants()) report.proposals[v] = Curves(recall.at(v));
   for (const auto& v : RegressionVariants()) {
     report.regression[v] = Curves(recall.at(v));
@@ -198,6 +228,17 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
   j["frames"] = r.frames;
   j["instances"] = r.instances;
   j["skipped_frames"] = SkippedFramesToJson(r.skipped);
+  const ReportedObstacleCounts& a = r.reported;
+  const auto per = [](int count, int frames) -> nlohmann::json {
+    return frames > 0 ? nlohmann::json(static_cast<double>(count) / frames) : nlohmann::json();
+  };
+  j["obstacles"] = {{"min_obstacle_score", DetectOptions{}.min_obstacle_score},
+                    {"false_alarms_per_frame", per(a.false_alarms, r.frames)},
+                    {"obstacle_free_frames", a.obstacle_free_frames},
+                    {"false_alarms_per_obstacle_free_frame",
+                     per(a.false_alarms_on_obstacle_free, a.obstacle_free_frames)},
+                    {"instances_found", per(a.instances_found, r.instances)}};
+  j["free_space"] = r.free_space;
   auto ar = [](const VariantCurves& c) {
     nlohmann::json a = nlohmann::json::object();
     for (const auto& [n, v] : c.ar_table) a[std::to_string(n)] = v;
@@ -222,6 +263,22 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
 std::string FormatEvalTables(const EvalReport& r) {
   std::ostringstream o;
   o << "frames " << r.frames << ", obstacle instances " << r.instances << "\n";
+  o << "free space (FPR, AP negatives): " << r.free_space << "\n";
+  {
+    const ReportedObstacleCounts& a = r.reported;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "reported obstacles (score >= %.2f): %.2f false alarms per frame, %.2f per "
+                  "obstacle-free frame (%d such frames), %.2f of instances found\n",
+                  DetectOptions{}.min_obstacle_score,
+                  r.frames ? static_cast<double>(a.false_alarms) / r.frames : 0.0,
+                  a.obstacle_free_frames ? static_cast<double>(a.false_alarms_on_obstacle_free) /
+                                               a.obstacle_free_frames
+                                         : 0.0,
+                  a.obstacle_free_frames,
+                  r.instances ? static_cast<double>(a.instances_found) / r.instances : 0.0);
+    o << text;
+  }
   for (const SkippedFrame& f : r.skipped)
     o << "skipped frame " << f.frame << ": " << f.reason << "\n";
   o << "\n";

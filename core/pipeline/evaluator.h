@@ -48,9 +48,22 @@ struct VariantCurves {
   std::map<int, double> ar_table;      // N = 200 ... 1000
 };
 
+// Obstacles as the detector reports them (calibrated score >= its default minimum), counted over
+// the split: a false alarm is a reported obstacle without a ground-truth obstacle pixel.
+struct ReportedObstacleCounts {
+  int false_alarms = 0;
+  int obstacle_free_frames = 0;
+  int false_alarms_on_obstacle_free = 0;
+  int instances_found = 0;  // ground-truth instances overlapped by a reported obstacle
+};
+
 struct EvalReport {
   int frames = 0;  // evaluated (skipped ones not counted)
   std::vector<SkippedFrame> skipped;
+  ReportedObstacleCounts reported;
+  // What the pixel metrics' negatives are: "road label" (LAF free space, MODDv2 water) or
+  // "every non-void pixel that is not an obstacle" (mask benchmarks without a road label).
+  std::string free_space;
   int instances = 0;
   std::map<std::string, VariantCurves> proposals;   // proposal variants
   std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)

@@ -212,6 +212,18 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
     auto loaded = OcclusionClassifier::Load(in, (root / kOcclusionFile).string());
     if (!loaded.ok()) return loaded.status();
     bundle.occlusion = std::move(*loaded);
+    // No silent fallback: an untrained classifier would paint mean-Ê boundaries instead of the
+    // learned occlusion edges. Only a manifest that switches the part off on purpose loads one.
+    const nlohmann::json parts = bundle.training.is_object()
+                                     ? bundle.training.value("parts", nlohmann::json::object())
+                                     : nlohmann::json::object();
+    const bool deliberately_off =
+        parts.contains("occlusion") && parts["occlusion"].value("off", false);
+    if (!bundle.occlusion.trained() && !deliberately_off)
+      return Status::FailedPrecondition(
+          (root / kOcclusionFile).string() +
+          ": the occlusion classifier is untrained and the manifest does not switch it off "
+          "(training.parts.occlusion.off)");
   }
   if (bundle.edge_kind == "pixel_forest") {
     auto bytes = checked(kEdgesFile);

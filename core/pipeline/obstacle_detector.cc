@@ -25,13 +25,29 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   return out;
 }
 
+std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
+                                             const std::vector<ScoredBox>& fused_boxes,
+                                             const PipelineParams& params,
+                                             const DetectOptions& options) {
+  const std::vector<ScoredBox> map_boxes = MapBoxes(fused_boxes, params.probability_map);
+  std::vector<DetectedObstacle> out;
+  for (const ObstacleComponent& c : ThresholdObstacles(probability, options.obstacle_threshold)) {
+    const float evidence = ObstacleEvidence(c.box, map_boxes);
+    const float score = static_cast<float>(CalibratedScore(params.obstacle_calibration, evidence));
+    if (score < options.min_obstacle_score) continue;
+    out.push_back({c.box, c.area, c.peak, c.mean, evidence, score});
+  }
+  return out;
+}
+
 ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
     : bundle_(std::move(bundle)) {
   info_.name = std::move(name);
   info_.version = bundle_.version;
   info_.format_version = kBundleFormatVersion;
   info_.created = bundle_.created;
-  info_.trained_on = bundle_.training.value("data", std::string());
+  info_.trained_on =
+      bundle_.training.is_object() ? bundle_.training.value("data", std::string()) : std::string();
   info_.edge_source = bundle_.edge_kind;
   info_.manifest = {
       {"version", bundle_.version},          {"created", bundle_.created},
@@ -69,8 +85,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   Detection out;
   out.width = bgr.cols;
   out.height = bgr.rows;
-  for (const ObstacleComponent& c : ThresholdObstacles(probability, options.obstacle_threshold))
-    out.obstacles.push_back({c.box, c.area, c.peak, c.mean});
+  out.obstacles = ScoreObstacles(probability, scored, bundle_.params, options);
   timer.Mark("probability_map");
 
   std::vector<std::size_t> order(fused.size());

@@ -20,6 +20,13 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
                                     const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                                     ProposalSet proposals, StageTimer* timer = nullptr);
 
+// The obstacles of a frame: components of P > obstacle_threshold, each with its evidence and
+// calibrated score, those scoring below min_obstacle_score left out.
+std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
+                                             const std::vector<ScoredBox>& fused_boxes,
+                                             const PipelineParams& params,
+                                             const DetectOptions& options);
+
 class ObstacleDetector final : public Detector {
  public:
   ObstacleDetector(ModelBundle bundle, std::string name);

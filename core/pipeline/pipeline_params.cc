@@ -21,10 +21,12 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FusionParams, beta1, keep_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score, nms_iou, max_boxes,
                                                 top_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PriorCorrection, edge_odds, occlusion_odds)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ObstacleCalibration, fitted, slope, intercept,
+                                                samples, positives)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradient_edges,
                                                 superpixels, boxes, multistride, size_filter,
-                                                region_merge_iou, prior_correction, fusion,
-                                                probability_map)
+                                                region_merge_iou, prior_correction,
+                                                obstacle_calibration, fusion, probability_map)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
 

@@ -9,6 +9,7 @@
 #include "core/edges/occlusion_classifier.h"
 #include "core/edges/sticky_superpixels.h"
 #include "core/pipeline/multilayer_regions.h"
+#include "core/pipeline/obstacle_calibration.h"
 #include "core/pipeline/probability_map.h"
 #include "core/proposals/edge_box_scorer.h"
 
@@ -50,6 +51,7 @@ struct PipelineParams {
   // boxes: on real frames more layers then *lowered* recall (README, "Real frames").
   float region_merge_iou = 0.75f;
   PriorCorrection prior_correction;
+  ObstacleCalibration obstacle_calibration;  // fitted by `tod train`
   FusionParams fusion;
   ProbabilityMapParams probability_map;
 };

@@ -33,12 +33,25 @@ std::vector<ScoredBox> RankedAboveThreshold(const std::vector<ScoredBox>& boxes,
   return kept;
 }
 
+std::vector<ScoredBox> MapBoxes(const std::vector<ScoredBox>& boxes,
+                                const ProbabilityMapParams& params) {
+  const std::vector<ScoredBox> ranked = RankedAboveThreshold(boxes, params.min_score);
+  std::vector<ScoredBox> kept = NonMaximumSuppression(ranked, params.nms_iou, params.max_boxes);
+  kept.resize(static_cast<std::size_t>(params.top_fraction * kept.size()));
+  return kept;
+}
+
+float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_boxes) {
+  float evidence = 0.f;
+  for (const ScoredBox& b : map_boxes)
+    if (!Intersect(b.box, component).empty()) evidence = std::max(evidence, b.score);
+  return evidence;
+}
+
 cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
                                    const ProbabilityMapParams& params) {
-  const std::vector<ScoredBox> ranked = RankedAboveThreshold(boxes, params.min_score);
-  const std::vector<ScoredBox> kept =
-      NonMaximumSuppression(ranked, params.nms_iou, params.max_boxes);
-  const std::size_t top = static_cast<std::size_t>(params.top_fraction * kept.size());
+  const std::vector<ScoredBox> kept = MapBoxes(boxes, params);
+  const std::size_t top = kept.size();
   // 2-D difference image: +s at the box's top-left, -s past its right / bottom, prefix sums.
   cv::Mat1d diff = cv::Mat1d::zeros(image_size.height + 1, image_size.width + 1);
   for (std::size_t i = 0; i < top; ++i) {

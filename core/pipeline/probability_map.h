@@ -32,6 +32,15 @@ struct ProbabilityMapParams {
 // recall of the regressed variants.
 std::vector<ScoredBox> RankedAboveThreshold(const std::vector<ScoredBox>& boxes, float min_score);
 
+// §7 steps 2-4: the boxes the map accumulates (score > min_score, NMS, the top fraction), by
+// descending score.
+std::vector<ScoredBox> MapBoxes(const std::vector<ScoredBox>& boxes,
+                                const ProbabilityMapParams& params = {});
+
+// The largest score of the map's boxes that overlap `component` (its bounding box): an
+// obstacle's evidence before the map is normalised (obstacle_calibration.h).
+float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_boxes);
+
 // §7 steps 2-5: threshold, NMS, top fraction, accumulate per pixel (difference image + prefix
 // sums, so the cost is linear in boxes plus pixels), normalise by the maximum.
 cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,

@@ -174,7 +174,7 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
   counts["superpixels"] = oaocc.superpixels.count;
   counts["occlusion_edge_pixels"] = CountAbove(oaocc.occlusion, options.edge_threshold);
   counts["regions"] = nlohmann::json::array();
-  long long total = 0;
+  std::vector<std::vector<ScoredBox>> per_region;
   for (int k = 0; k < layers; ++k) {
     EdgeBoxStats stats;
     const std::vector<ScoredBox> boxes = ProposeRegionBoxes(
@@ -195,9 +195,11 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
     region["proposals_kept"] = boxes.size();
     region["proposals_drawn"] = drawn;
     counts["regions"].push_back(std::move(region));
-    total += static_cast<long long>(boxes.size());
+    per_region.push_back(boxes);
   }
-  counts["proposals_total"] = total;
+  // After the cross-region merge, as the detector regresses them.
+  counts["proposals_total"] =
+      MergeRegionBoxes(per_region, bundle.params.region_merge_iou).boxes.size();
   return out;
 }
 

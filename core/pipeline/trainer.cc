@@ -1,5 +1,7 @@
 #include "core/pipeline/trainer.h"
 
+#include <sys/resource.h>
+
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -19,7 +21,255 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Rows of `all` selected by `indices`, as a proposal subset for feature extraction.
+double PeakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes
+}
+
+// One training run: the split, progress lines (each with the peak RSS so far), step timings.
+// Frames are streamed: every step loads the frames it visits and keeps only what the next step
+// needs (samples, statistics), so memory does not grow with the number of frames.
+class TrainingRun {
+ public:
+  explicit TrainingRun(const TrainOptions& options) : options_(options) {}
+
+  Status Open() {
+    auto selection = SelectFrames({options_.data_root, options_.split, options_.format,
+                                   options_.split_file, options_.max_frames});
+    if (!selection.ok()) return selection.status();
+    selection_ = std::move(*selection);
+    frames_ = selection_.frames;
+    return Status::Ok();
+  }
+
+  void Say(const std::string& line) {
+    if (!options_.progress) return;
+    std::lock_guard lock(say_mutex_);
+    char rss[48];
+    std::snprintf(rss, sizeof rss, " [peak RSS %.0f MB]", PeakRssMb());
+    options_.progress(line + rss);
+  }
+  void StartStep() { step_started_ = Clock::now(); }
+  void EndStep(const std::string& name) { seconds_[name] = SecondsSince(step_started_); }
+
+  // Runs body(frame index, sample) over `which` (positions into frames()), loading each frame
+  // when it is visited. A frame that fails is that frame's error.
+  std::vector<Status> ForEachFrame(const std::vector<int>& which,
+                                   const std::function<Status(int, const Sample&)>& body) {
+    return ParallelFor(static_cast<int>(which.size()), options_.threads, [&](int j) -> Status {
+      auto sample = selection_.dataset->Load(frames_[which[j]]);
+      if (!sample.ok()) return sample.status();
+      return body(which[j], *sample);
+    });
+  }
+  // The error of the first frame that failed, named.
+  Status FirstError(const std::vector<int>& which, const std::vector<Status>& statuses) const {
+    for (std::size_t j = 0; j < statuses.size(); ++j)
+      if (!statuses[j].ok()) return statuses[j].WithContext("frame " + FrameName(which[j]));
+    return Status::Ok();
+  }
+  std::string FrameName(int position) const { return selection_.dataset->name(frames_[position]); }
+
+  const TrainOptions& options() const { return options_; }
+  const std::string& format() const { return selection_.format; }
+  int num_frames() const { return static_cast<int>(frames_.size()); }
+  const nlohmann::json& seconds() const { return seconds_; }
+  Clock::time_point started() const { return started_; }
+
+ private:
+  const TrainOptions& options_;
+  FrameSelection selection_;
+  std::vector<int> frames_;
+  std::mutex say_mutex_;
+  Clock::time_point started_ = Clock::now();
+  Clock::time_point step_started_ = Clock::now();
+  nlohmann::json seconds_ = nlohmann::json::object();
+};
+
+// What the first pass over the split learns: the frame size, the obstacles, the usable frames.
+struct Survey {
+  int width = 0, height = 0;
+  std::vector<ObstacleFootprint> footprints;
+  std::vector<Box> obstacle_boxes;
+  std::vector<int> usable;  // positions of the frames every later step visits
+  std::vector<SkippedFrame> skipped;
+};
+
+Result<Survey> SurveyFrames(TrainingRun& run) {
+  const int n = run.num_frames();
+  run.Say("surveying " + std::to_string(n) + " training frames from " + run.options().data_root);
+  std::vector<int> all(n);
+  for (int i = 0; i < n; ++i) all[i] = i;
+  std::vector<cv::Size> sizes(n);
+  std::vector<std::vector<ObstacleFootprint>> per_frame(n);
+  const std::vector<Status> statuses = run.ForEachFrame(all, [&](int i, const Sample& s) {
+    sizes[i] = s.image.size();
+    for (const ObstacleInstance& inst : s.instances)
+      per_frame[i].push_back({inst.box, inst.pixel_count()});
+    return Status::Ok();
+  });
+  Survey survey;
+  const Status bad = ApplyBadFramePolicy(
+      statuses, [&](int i) { return run.FrameName(i); }, run.options().on_bad_frame,
+      &survey.skipped);
+  if (!bad.ok()) return bad;
+  for (const SkippedFrame& f : survey.skipped)
+    run.Say("skipped frame " + f.frame + ": " + f.reason);
+  for (int i = 0; i < n; ++i) {
+    if (!statuses[i].ok()) continue;
+    if (survey.usable.empty()) survey.width = sizes[i].width, survey.height = sizes[i].height;
+    if (sizes[i] != cv::Size(survey.width, survey.height)) {
+      return Status::InvalidArgument(
+          "frame " + run.FrameName(i) + " is " + std::to_string(sizes[i].width) + "x" +
+          std::to_string(sizes[i].height) + ", the split's first frame " +
+          std::to_string(survey.width) + "x" + std::to_string(survey.height) +
+          ": train on frames of one camera (a bundle then maps onto any frame size)");
+    }
+    survey.usable.push_back(i);
+    for (const ObstacleFootprint& f : per_frame[i]) {
+      survey.footprints.push_back(f);
+      survey.obstacle_boxes.push_back(f.box);
+    }
+  }
+  if (survey.usable.empty()) return Status::InvalidArgument("no usable training frame");
+  run.Say(std::to_string(survey.footprints.size()) + " training obstacles in " +
+          std::to_string(survey.usable.size()) + " frames");
+  return survey;
+}
+
+// Multilayer regions and the size filter from the training obstacles (§1.4, §4.3).
+Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundle) {
+  const TrainOptions& options = run.options();
+  if (options.regions == "laf2020") {
+    bundle.regions = Laf2020Regions().ScaledTo(survey.width, survey.height);
+    bundle.size_filter = SizeFilter::Laf2020();
+    if (survey.width != 2048 || survey.height != 1024)
+      bundle.size_filter = SizeFilter::Derive(survey.obstacle_boxes);
+  } else if (options.regions == "auto") {
+    RegionParams region_params = options.params.regions;
+    region_params.seed = options.seed;
+    auto regions =
+        DeriveMultilayerRegions(survey.footprints, survey.width, survey.height, region_params);
+    if (!regions.ok()) return regions.status().WithContext("deriving the multilayer regions");
+    bundle.regions = *regions;
+    bundle.size_filter = SizeFilter::Derive(survey.obstacle_boxes);
+  } else {
+    return Status::InvalidArgument("--regions must be auto or laf2020, got '" + options.regions +
+                                   "'");
+  }
+  bundle.size_filter.enabled = options.params.size_filter;
+  for (int k = 0; k < bundle.regions.num_layers(); ++k) {
+    const Box& r = bundle.regions.layers[k];
+    char line[96];  // snprintf: GCC 12 warns (-Wrestrict, falsely) on "R" + std::to_string
+    std::snprintf(line, sizeof line, "R%d = [%d, %d, %d x %d]", k + 1, r.x, r.y, r.w, r.h);
+    run.Say(line);
+  }
+  return Status::Ok();
+}
+
+// Positions of the frames the edge and occlusion classifiers learn from.
+std::vector<int> ClassifierFrames(const TrainingRun& run, const Survey& survey) {
+  std::vector<int> out;
+  const int count = static_cast<int>(survey.usable.size());
+  for (int j : SpreadIndices(count, run.options().classifier_frames))
+    out.push_back(survey.usable[j]);
+  return out;
+}
+
+// §3.4 step 1: the base edge source. Samples are extracted frame by frame.
+Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
+                       nlohmann::json& parts) {
+  const TrainOptions& options = run.options();
+  bundle.edge_kind = options.edge_source;
+  if (options.edge_source == "gradient") {
+    bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
+    parts["edges"] = {{"kind", "gradient"}, {"learned", false}};
+    return Status::Ok();
+  }
+  if (options.edge_source == "sed") {
+    auto sed = CreateSedEdgeSource(options.sed_model);
+    if (!sed.ok()) return sed.status().WithContext("loading the SED edge model");
+    bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
+    parts["edges"] = {{"kind", "sed"}, {"learned", false}, {"model", options.sed_model}};
+    return Status::Ok();
+  }
+  if (options.edge_source != "pixel_forest")
+    return Status::InvalidArgument("unknown edge source '" + options.edge_source +
+                                   "' (pixel_forest, gradient, sed)");
+  const std::vector<int> which = ClassifierFrames(run, survey);
+  PixelEdgeParams edge_params = options.edge_params;
+  edge_params.forest.seed = options.seed;
+  run.Say("pixel edge classifier: samples from " + std::to_string(which.size()) + " frames");
+  const Box r1 = bundle.regions.layers.front();
+  std::vector<EdgeSamples> per_frame(run.num_frames());
+  const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
+    const EdgeTrainingFrame frame{s.image(r1.rect()).clone(), LabelMap(s)(r1.rect()).clone()};
+    auto samples = ExtractEdgeSamples(frame, edge_params, static_cast<std::size_t>(i));
+    if (!samples.ok()) return samples.status();
+    per_frame[i] = std::move(*samples);
+    return Status::Ok();
+  }));
+  if (!st.ok()) return st.WithContext("pixel edge classifier");
+  EdgeSamples all;
+  for (const EdgeSamples& f : per_frame) AppendEdgeSamples(all, f);
+  per_frame.clear();
+  run.Say("training the pixel edge classifier on " + std::to_string(all.targets.size()) +
+          " samples");
+  auto classifier = PixelEdgeClassifier::TrainOnSamples(all, edge_params);
+  if (!classifier.ok())
+    return classifier.status().WithContext("training the pixel edge classifier");
+  bundle.params.prior_correction.edge_odds =
+      options.prior_correction ? classifier->sampled_odds_scale() : 1.0;
+  parts["edges"] = {{"kind", "pixel_forest"},
+                    {"learned", true},
+                    {"trained", true},
+                    {"frames", which.size()},
+                    {"samples", all.targets.size()},
+                    {"prior_odds", bundle.params.prior_correction.edge_odds}};
+  bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*classifier));
+  return Status::Ok();
+}
+
+// §3.4 steps 2-5: the occlusion classifier on superpixel boundaries, pairs frame by frame.
+Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
+                                nlohmann::json& parts) {
+  const TrainOptions& options = run.options();
+  const std::vector<int> which = ClassifierFrames(run, survey);
+  OcclusionParams params = options.occlusion_params;
+  params.forest.seed = options.seed;
+  run.Say("occlusion classifier: pairs from " + std::to_string(which.size()) + " frames");
+  std::vector<OcclusionSamples> per_frame(run.num_frames());
+  const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
+    const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges,
+                                                       nullptr, bundle.params, /*enhance=*/true);
+    const OcclusionTrainingFrame frame{oaocc.crop, oaocc.enhanced, oaocc.superpixels,
+                                       LabelMap(s)(oaocc.r1.rect()).clone()};
+    auto samples = ExtractOcclusionSamples(frame, params, static_cast<std::size_t>(i));
+    if (!samples.ok()) return samples.status();
+    per_frame[i] = std::move(*samples);
+    return Status::Ok();
+  }));
+  if (!st.ok()) return st.WithContext("occlusion classifier");
+  OcclusionSamples all;
+  for (const OcclusionSamples& f : per_frame) AppendOcclusionSamples(all, f);
+  per_frame.clear();
+  const std::size_t positives = all.positive_targets.size();
+  run.Say("training the occlusion classifier on " + std::to_string(positives) + " contour pairs");
+  auto classifier = OcclusionClassifier::FitOnSamples(std::move(all), params);
+  if (!classifier.ok()) return classifier.status().WithContext("training the occlusion classifier");
+  bundle.occlusion = std::move(*classifier);
+  bundle.params.prior_correction.occlusion_odds =
+      options.prior_correction ? bundle.occlusion.sampled_odds_scale() : 1.0;
+  parts["occlusion"] = {{"learned", true},
+                        {"trained", true},
+                        {"frames", which.size()},
+                        {"contour_pairs", positives},
+                        {"prior_odds", bundle.params.prior_correction.occlusion_odds}};
+  return Status::Ok();
+}
+
+// Rows of ProposalSet `all` selected by `indices`, as a proposal subset for feature extraction.
 ProposalSet Subset(const ProposalSet& all, const std::vector<int>& indices) {
   ProposalSet out;
   for (int i : indices) {
@@ -27,6 +277,153 @@ ProposalSet Subset(const ProposalSet& all, const std::vector<int>& indices) {
     out.layer.push_back(all.layer[i]);
   }
   return out;
+}
+
+// ORDR and OBDR samples of every frame (§6), kept per frame for the calibration folds.
+struct RegressorSamples {
+  std::vector<cv::Mat1f> ordr_rows, obdr_rows;
+  std::vector<std::vector<float>> ordr_targets, obdr_targets;
+  long long proposals = 0;
+};
+
+Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey& survey,
+                                                 const ModelBundle& bundle) {
+  const TrainOptions& options = run.options();
+  const int n = run.num_frames();
+  RegressorSamples out;
+  out.ordr_rows.resize(n), out.obdr_rows.resize(n);
+  out.ordr_targets.resize(n), out.obdr_targets.resize(n);
+  std::vector<long long> proposals(n, 0);
+  const std::vector<int> limits = bundle.regions.RangeLimits();
+  std::atomic<int> done{0};
+  const Status st =
+      run.FirstError(survey.usable, run.ForEachFrame(survey.usable, [&](int i, const Sample& s) {
+        if (cv::countNonZero(s.road) > 0) {
+          const OcclusionEdges oaocc = ComputeOcclusionEdges(
+              s.image, bundle.regions, *bundle.edges, &bundle.occlusion, bundle.params, true);
+          const ProposalSet all =
+              ProposeBoxes(oaocc, bundle.regions, bundle.params.boxes,
+                           DetectorProposalOptions(bundle.params, bundle.regions.num_layers()),
+                           bundle.size_filter);
+          proposals[i] = static_cast<long long>(all.boxes.size());
+          auto selected =
+              SelectTrainingSamples(all.boxes, s, limits, options.selection,
+                                    options.seed * 1000003ULL + static_cast<unsigned>(i));
+          if (!selected.ok()) return selected.status();
+          out.ordr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
+                                                     Subset(all, selected->ordr_indices));
+          out.obdr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
+                                                     Subset(all, selected->obdr_indices));
+          out.ordr_targets[i] = selected->ordr_targets;
+          out.obdr_targets[i] = selected->obdr_targets;
+        }
+        const int finished = ++done;
+        if (finished % 10 == 0 || finished == static_cast<int>(survey.usable.size()))
+          run.Say("proposals and samples: " + std::to_string(finished) + "/" +
+                  std::to_string(survey.usable.size()) + " frames");
+        return Status::Ok();
+      }));
+  if (!st.ok()) return st.WithContext("collecting regressor samples");
+  for (long long c : proposals) out.proposals += c;
+  return out;
+}
+
+// The regressors trained on the samples of the frames `in_fold(i)` accepts.
+struct Regressors {
+  RandomForest ordr, obdr;
+  int ordr_samples = 0, obdr_samples = 0;
+};
+Result<Regressors> TrainRegressorPair(const RegressorSamples& samples,
+                                      const std::function<bool(int)>& in_fold,
+                                      ForestParams forest) {
+  const auto stack = [&](const std::vector<cv::Mat1f>& parts,
+                         const std::vector<std::vector<float>>& targets, cv::Mat1f& rows,
+                         std::vector<float>& y) {
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      if (parts[i].empty() || !in_fold(static_cast<int>(i))) continue;
+      rows.push_back(parts[i]);
+      y.insert(y.end(), targets[i].begin(), targets[i].end());
+    }
+  };
+  cv::Mat1f ordr_x, obdr_x;
+  std::vector<float> ordr_y, obdr_y;
+  stack(samples.ordr_rows, samples.ordr_targets, ordr_x, ordr_y);
+  stack(samples.obdr_rows, samples.obdr_targets, obdr_x, obdr_y);
+  constexpr int kMinSamples = 10;
+  if (ordr_x.rows < kMinSamples || obdr_x.rows < kMinSamples)
+    return Status::InvalidArgument(
+        "too few training samples for the regressors (" + std::to_string(ordr_x.rows) + " ORDR, " +
+        std::to_string(obdr_x.rows) + " OBDR, need " + std::to_string(kMinSamples) +
+        "); need frames with obstacles and free space");
+  Regressors out;
+  auto ordr = RandomForest::Fit(ordr_x, ordr_y, forest);
+  if (!ordr.ok()) return ordr.status().WithContext("ORDR");
+  forest.seed += 1;
+  auto obdr = RandomForest::Fit(obdr_x, obdr_y, forest);
+  if (!obdr.ok()) return obdr.status().WithContext("OBDR");
+  out.ordr = std::move(*ordr);
+  out.obdr = std::move(*obdr);
+  out.ordr_samples = ordr_x.rows;
+  out.obdr_samples = obdr_x.rows;
+  return out;
+}
+
+ForestParams RegressorForest(const TrainOptions& options) {
+  ForestParams forest = options.regressor;
+  forest.seed = options.seed;
+  forest.threads = options.threads;
+  return forest;
+}
+
+// Calibration of the obstacles' scores (obstacle_calibration.h). The regressors fit their own
+// training frames closely, so scores on those frames would be overconfident: each frame is
+// scored by regressors trained on the other fold of frames (2-fold cross-fitting), then Platt
+// scaling of "covers an obstacle pixel" on the evidence of every component found.
+Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
+                               const RegressorSamples& samples, ModelBundle& bundle,
+                               nlohmann::json& parts) {
+  constexpr int kFolds = 2;
+  const auto fold_of = [](int position) { return position % kFolds; };
+  std::vector<std::vector<std::pair<double, int>>> per_frame(run.num_frames());
+  for (int fold = 0; fold < kFolds; ++fold) {
+    std::vector<int> which;
+    for (int i : survey.usable)
+      if (fold_of(i) == fold) which.push_back(i);
+    if (which.empty()) continue;
+    auto pair = TrainRegressorPair(
+        samples, [&](int i) { return fold_of(i) != fold; }, RegressorForest(run.options()));
+    if (!pair.ok()) return pair.status().WithContext("calibration fold " + std::to_string(fold));
+    ModelBundle fold_bundle = bundle;
+    fold_bundle.ordr = std::move(pair->ordr);
+    fold_bundle.obdr = std::move(pair->obdr);
+    const ObstacleDetector detector(std::move(fold_bundle), "calibration");
+    DetectOptions options;
+    options.min_obstacle_score = -1.f;  // every component
+    options.want_probability_map = false;
+    const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
+      auto detection = detector.Detect(s.image, options);
+      if (!detection.ok()) return detection.status();
+      for (const DetectedObstacle& o : detection->obstacles) {
+        const bool on_obstacle = cv::countNonZero(s.obstacle(o.box.rect())) > 0;
+        per_frame[i].emplace_back(o.evidence, on_obstacle ? 1 : 0);
+      }
+      return Status::Ok();
+    }));
+    if (!st.ok()) return st.WithContext("calibrating obstacle scores");
+  }
+  std::vector<double> evidence;
+  std::vector<int> labels;
+  for (const auto& frame : per_frame)
+    for (const auto& [e, label] : frame) evidence.push_back(e), labels.push_back(label);
+  auto fitted = FitObstacleCalibration(evidence, labels);
+  if (!fitted.ok()) return fitted.status().WithContext("calibrating obstacle scores");
+  bundle.params.obstacle_calibration = *fitted;
+  parts["calibration"] = {{"learned", true},
+                          {"trained", true},
+                          {"folds", kFolds},
+                          {"components", fitted->samples},
+                          {"on_obstacles", fitted->positives}};
+  return Status::Ok();
 }
 
 }  // namespace
@@ -48,216 +445,80 @@ cv::Mat1i LabelMap(const Sample& sample) {
 }
 
 Result<ModelBundle> TrainModel(const TrainOptions& options) {
-  auto say = [&](const std::string& line) {
-    if (options.progress) options.progress(line);
-  };
-  const auto started = Clock::now();
-  auto selection = SelectFrames(
-      {options.data_root, options.split, options.format, options.split_file, options.max_frames});
-  if (!selection.ok()) return selection.status();
-  const Dataset& dataset = *selection->dataset;
-  const std::string& format = selection->format;
-  const std::vector<int>& frame_ids = selection->frames;
-  const int n = static_cast<int>(frame_ids.size());
-
-  // 1. Read the split (kept in memory: every later step visits every frame).
-  say("reading " + std::to_string(n) + " training frames from " + options.data_root);
-  std::vector<Sample> frames(n);
-  const std::vector<Status> errors = ParallelFor(n, options.threads, [&](int i) -> Status {
-    auto s = dataset.Load(frame_ids[i]);
-    if (!s.ok()) return s.status();
-    frames[i] = std::move(*s);
-    return Status::Ok();
-  });
-  for (const Status& e : errors)
-    if (!e.ok()) return e;
-  const int width = frames.front().image.cols, height = frames.front().image.rows;
-  for (const Sample& s : frames)
-    if (s.image.cols != width || s.image.rows != height)
-      return Status::InvalidArgument(s.image_path +
-                                     ": frame size differs from the split's first frame (" +
-                                     std::to_string(width) + "x" + std::to_string(height) + ")");
-
-  // 2. Multilayer regions and the size filter from the training obstacles (§1.4, §4.3).
+  TrainingRun run(options);
+  if (Status st = run.Open(); !st.ok()) return st;
   ModelBundle bundle;
   bundle.params = options.params;
-  std::vector<ObstacleFootprint> footprints;
-  std::vector<Box> obstacle_boxes;
-  for (const Sample& s : frames)
-    for (const ObstacleInstance& inst : s.instances) {
-      footprints.push_back({inst.box, inst.pixel_count()});
-      obstacle_boxes.push_back(inst.box);
-    }
-  say(std::to_string(footprints.size()) + " training obstacles");
-  if (options.regions == "laf2020") {
-    bundle.regions = Laf2020Regions().ScaledTo(width, height);
-    bundle.size_filter = SizeFilter::Laf2020();
-    if (width != 2048 || height != 1024) bundle.size_filter = SizeFilter::Derive(obstacle_boxes);
-  } else if (options.regions == "auto") {
-    RegionParams region_params = options.params.regions;
-    region_params.seed = options.seed;
-    auto regions = DeriveMultilayerRegions(footprints, width, height, region_params);
-    if (!regions.ok()) return regions.status();
-    bundle.regions = *regions;
-    bundle.size_filter = SizeFilter::Derive(obstacle_boxes);
-  } else {
-    return Status::InvalidArgument("--regions must be auto or laf2020, got '" + options.regions +
-                                   "'");
-  }
-  bundle.size_filter.enabled = options.params.size_filter;
-  for (int k = 0; k < bundle.regions.num_layers(); ++k) {
-    const Box& r = bundle.regions.layers[k];
-    say("R" + std::to_string(k + 1) + " = [" + std::to_string(r.x) + ", " + std::to_string(r.y) +
-        ", " + std::to_string(r.w) + " x " + std::to_string(r.h) + "]");
-  }
+  nlohmann::json parts = nlohmann::json::object();
 
-  // 3. Base edge source (§3.4 step 1).
-  const std::vector<int> classifier_ids = SpreadIndices(n, options.classifier_frames);
-  const Box r1 = bundle.regions.layers.front();
-  auto t0 = Clock::now();
-  bundle.edge_kind = options.edge_source;
-  if (options.edge_source == "pixel_forest") {
-    std::vector<EdgeTrainingFrame> edge_frames;
-    for (int i : classifier_ids)
-      edge_frames.push_back(
-          {frames[i].image(r1.rect()).clone(), LabelMap(frames[i])(r1.rect()).clone()});
-    PixelEdgeParams edge_params = options.edge_params;
-    edge_params.forest.seed = options.seed;
-    say("training the pixel edge classifier on " + std::to_string(edge_frames.size()) + " frames");
-    auto classifier = PixelEdgeClassifier::TryTrain(edge_frames, edge_params);
-    if (!classifier.ok())
-      return classifier.status().WithContext("training the pixel edge classifier");
-    bundle.params.prior_correction.edge_odds =
-        options.prior_correction ? classifier->sampled_odds_scale() : 1.0;
-    bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*classifier));
-  } else if (options.edge_source == "gradient") {
-    bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
-  } else if (options.edge_source == "sed") {
-    auto sed = CreateSedEdgeSource(options.sed_model);
-    if (!sed.ok()) return sed.status();
-    bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
-  } else {
-    return Status::InvalidArgument("unknown edge source '" + options.edge_source +
-                                   "' (pixel_forest, gradient, sed)");
-  }
-  const double edge_seconds = SecondsSince(t0);
+  run.StartStep();
+  auto survey = SurveyFrames(run);
+  if (!survey.ok()) return survey.status();
+  if (Status st = DeriveGeometry(run, *survey, bundle); !st.ok()) return st;
+  run.EndStep("survey");
 
-  // 4. Occlusion classifier on superpixel boundaries (§3.4 steps 2-5).
-  t0 = Clock::now();
-  std::vector<OcclusionTrainingFrame> occlusion_frames(classifier_ids.size());
-  (void)ParallelFor(static_cast<int>(classifier_ids.size()), options.threads, [&](int j) {
-    const Sample& s = frames[classifier_ids[j]];
-    OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges, nullptr,
-                                                 bundle.params, /*enhance=*/true);
-    occlusion_frames[j] = {oaocc.crop.clone(), oaocc.enhanced, oaocc.superpixels,
-                           LabelMap(s)(oaocc.r1.rect()).clone()};
-    return Status::Ok();
-  });
-  OcclusionParams occlusion_params = options.occlusion_params;
-  occlusion_params.forest.seed = options.seed;
-  say("training the occlusion classifier on " + std::to_string(occlusion_frames.size()) +
-      " frames");
-  auto occlusion = OcclusionClassifier::Fit(occlusion_frames, occlusion_params);
-  if (!occlusion.ok()) return occlusion.status().WithContext("training the occlusion classifier");
-  bundle.occlusion = std::move(*occlusion);
-  bundle.params.prior_correction.occlusion_odds =
-      options.prior_correction ? bundle.occlusion.sampled_odds_scale() : 1.0;
-  occlusion_frames.clear();
-  const double occlusion_seconds = SecondsSince(t0);
+  run.StartStep();
+  if (Status st = TrainEdgeSource(run, *survey, bundle, parts); !st.ok()) return st;
+  run.EndStep("edges");
 
-  // 5. ORDR and OBDR on the full test-time proposal set of every frame (§6).
-  t0 = Clock::now();
-  const std::vector<int> limits = bundle.regions.RangeLimits();
-  std::vector<cv::Mat1f> ordr_rows(n), obdr_rows(n);
-  std::vector<std::vector<float>> ordr_targets(n), obdr_targets(n);
-  std::vector<long long> proposal_counts(n, 0);
-  std::atomic<int> done{0};
-  std::mutex say_mutex;
-  (void)ParallelFor(n, options.threads, [&](int i) {
-    const Sample& s = frames[i];
-    if (cv::countNonZero(s.road) > 0) {
-      const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges,
-                                                         &bundle.occlusion, bundle.params, true);
-      const ProposalOptions popts =
-          DetectorProposalOptions(bundle.params, bundle.regions.num_layers());
-      const ProposalSet all =
-          ProposeBoxes(oaocc, bundle.regions, bundle.params.boxes, popts, bundle.size_filter);
-      proposal_counts[i] = static_cast<long long>(all.boxes.size());
-      auto selected = SelectTrainingSamples(all.boxes, s, limits, options.selection,
-                                            options.seed * 1000003ULL + static_cast<unsigned>(i));
-      if (selected.ok()) {
-        ordr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
-                                               Subset(all, selected->ordr_indices));
-        obdr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
-                                               Subset(all, selected->obdr_indices));
-        ordr_targets[i] = selected->ordr_targets;
-        obdr_targets[i] = selected->obdr_targets;
-      }
-    }
-    const int finished = ++done;
-    if (finished % 10 == 0 || finished == n) {
-      std::lock_guard lock(say_mutex);
-      say("proposals and samples: " + std::to_string(finished) + "/" + std::to_string(n) +
-          " frames");
-    }
-    return Status::Ok();
-  });
-  auto stack = [](const std::vector<cv::Mat1f>& parts,
-                  const std::vector<std::vector<float>>& targets, cv::Mat1f& rows,
-                  std::vector<float>& y) {
-    for (std::size_t i = 0; i < parts.size(); ++i) {
-      if (parts[i].empty()) continue;
-      rows.push_back(parts[i]);
-      y.insert(y.end(), targets[i].begin(), targets[i].end());
-    }
-  };
-  cv::Mat1f ordr_x, obdr_x;
-  std::vector<float> ordr_y, obdr_y;
-  stack(ordr_rows, ordr_targets, ordr_x, ordr_y);
-  stack(obdr_rows, obdr_targets, obdr_x, obdr_y);
-  if (ordr_x.rows < 10 || obdr_x.rows < 10)
-    return Status::InvalidArgument(
-        options.data_root + ": too few training samples for the regressors (" +
-        std::to_string(ordr_x.rows) + " ORDR, " + std::to_string(obdr_x.rows) +
-        " OBDR); need frames with road and obstacles");
-  const double proposal_seconds = SecondsSince(t0);
-  t0 = Clock::now();
-  ForestParams forest = options.regressor;
-  forest.seed = options.seed;
-  forest.threads = options.threads;
-  say("training ORDR on " + std::to_string(ordr_x.rows) + " samples");
-  bundle.ordr = RandomForest::Train(ordr_x, ordr_y, forest);
-  forest.seed = options.seed + 1;
-  say("training OBDR on " + std::to_string(obdr_x.rows) + " samples");
-  bundle.obdr = RandomForest::Train(obdr_x, obdr_y, forest);
-  const double regressor_seconds = SecondsSince(t0);
+  run.StartStep();
+  if (Status st = TrainOcclusionClassifier(run, *survey, bundle, parts); !st.ok()) return st;
+  run.EndStep("occlusion");
 
-  long long proposals_total = 0;
-  for (long long c : proposal_counts) proposals_total += c;
+  run.StartStep();
+  auto samples = CollectRegressorSamples(run, *survey, bundle);
+  if (!samples.ok()) return samples.status();
+  run.EndStep("proposals_and_samples");
+
+  run.StartStep();
+  run.Say("training ORDR and OBDR");
+  auto regressors = TrainRegressorPair(
+      *samples, [](int) { return true; }, RegressorForest(options));
+  if (!regressors.ok()) return regressors.status().WithContext("training the regressors");
+  bundle.ordr = std::move(regressors->ordr);
+  bundle.obdr = std::move(regressors->obdr);
+  const ForestParams forest = RegressorForest(options);
+  for (const char* name : {"ordr", "obdr"})
+    parts[name] = {{"learned", true},
+                   {"trained", true},
+                   {"samples", std::string(name) == "ordr" ? regressors->ordr_samples
+                                                           : regressors->obdr_samples},
+                   {"trees", forest.num_trees},
+                   {"mtry", forest.max_features},
+                   {"min_leaf", forest.min_leaf_size}};
+  run.EndStep("regressors");
+
+  run.StartStep();
+  run.Say("calibrating obstacle scores (2-fold)");
+  if (Status st = CalibrateObstacleScores(run, *survey, *samples, bundle, parts); !st.ok())
+    return st;
+  run.EndStep("calibration");
+
+  const int n = static_cast<int>(survey->usable.size());
+  nlohmann::json seconds = run.seconds();
+  seconds["total"] = SecondsSince(run.started());
   bundle.training = {{"data", options.data_root},
-                     {"format", format},
+                     {"format", run.format()},
                      {"split", options.split},
                      {"frames", n},
-                     {"frame_size", {width, height}},
-                     {"obstacles", footprints.size()},
+                     {"skipped_frames", SkippedFramesToJson(survey->skipped)},
+                     {"frame_size", {survey->width, survey->height}},
+                     {"obstacles", survey->footprints.size()},
                      {"regions_from", options.regions},
                      {"seed", options.seed},
-                     {"classifier_frames", classifier_ids.size()},
-                     {"mean_proposals_per_frame", static_cast<double>(proposals_total) / n},
-                     {"ordr_samples", ordr_x.rows},
-                     {"obdr_samples", obdr_x.rows},
+                     {"classifier_frames", ClassifierFrames(run, *survey).size()},
+                     {"mean_proposals_per_frame", static_cast<double>(samples->proposals) / n},
+                     {"ordr_samples", regressors->ordr_samples},
+                     {"obdr_samples", regressors->obdr_samples},
+                     {"parts", parts},
                      {"regressor",
                       {{"trees", forest.num_trees},
                        {"mtry", forest.max_features},
                        {"min_leaf", forest.min_leaf_size}}},
-                     {"seconds",
-                      {{"edges", edge_seconds},
-                       {"occlusion", occlusion_seconds},
-                       {"proposals_and_samples", proposal_seconds},
-                       {"regressors", regressor_seconds},
-                       {"total", SecondsSince(started)}}}};
+                     {"peak_rss_mb", PeakRssMb()},
+                     {"seconds", seconds}};
   bundle.version = "tod-" + NowIso8601().substr(0, 10) + "-seed" + std::to_string(options.seed);
-  say("trained in " + std::to_string(static_cast<int>(SecondsSince(started))) + " s");
+  run.Say("trained in " + std::to_string(static_cast<int>(seconds["total"].get<double>())) + " s");
   return bundle;
 }
 

@@ -1,6 +1,8 @@
 // `tod train`: learns every part of the model from a dataset's training split - multilayer
-// regions, size filter, pixel edge classifier, occlusion classifier, ORDR and OBDR - and returns
-// the bundle (the caller saves it).
+// regions, size filter, pixel edge classifier, occlusion classifier, ORDR and OBDR, the obstacle
+// score calibration - and returns the bundle (the caller saves it). Frames are streamed through
+// the steps (memory does not grow with the split); a part that cannot be trained fails the run
+// with a message naming the step; the manifest records what each part was trained on.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +13,7 @@
 #include "core/edges/occlusion_classifier.h"
 #include "core/features/sample_selection.h"
 #include "core/forest/random_forest.h"
+#include "core/pipeline/bad_frames.h"
 #include "core/pipeline/model_bundle.h"
 
 namespace tod {
@@ -28,6 +31,7 @@ struct TrainOptions {
   int classifier_frames = 60;    // frames used for the edge and occlusion classifiers
   int threads = 0;               // 0 = all cores
   bool prior_correction = true;  // undo the classifiers' balanced sampling (PriorCorrection)
+  BadFramePolicy on_bad_frame = BadFramePolicy::kFail;
   PipelineParams params;
   PixelEdgeParams edge_params;
   OcclusionParams occlusion_params;

@@ -68,6 +68,10 @@ Status InferenceEngine::ValidateOptions(const DetectOptions& options) const {
     return Status::InvalidArgument(
         "obstacle_threshold: " + std::to_string(options.obstacle_threshold) + " is outside [0, 1]");
   }
+  if (!(options.min_obstacle_score >= 0.f && options.min_obstacle_score <= 1.f)) {
+    return Status::InvalidArgument(
+        "min_obstacle_score: " + std::to_string(options.min_obstacle_score) + " is outside [0, 1]");
+  }
   return Status::Ok();
 }
 

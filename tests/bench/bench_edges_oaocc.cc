@@ -99,7 +99,7 @@ int main() {
   }
   tod::OcclusionParams params;  // 100 trees, the default
   params.forest.threads = 1;
-  const OcclusionClassifier trained = OcclusionClassifier::Train(frames, params);
+  const OcclusionClassifier trained = std::move(OcclusionClassifier::Fit(frames, params)).value();
   const OcclusionClassifier fallback;
 
   std::printf("crop 1800x620, single thread, median thread-CPU ms of %d runs\n", kRuns);

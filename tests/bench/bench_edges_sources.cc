@@ -86,7 +86,8 @@ int main() {
   for (int seed = 10; seed < 16; ++seed) frames.push_back(MakeScene(640, 240, seed));
   tod::PixelEdgeParams params;  // paper defaults: 4000 samples / frame, 8 trees, depth 20
   const auto train_start = std::chrono::steady_clock::now();
-  const tod::PixelEdgeClassifier classifier = tod::PixelEdgeClassifier::Train(frames, params);
+  const tod::PixelEdgeClassifier classifier =
+      std::move(tod::PixelEdgeClassifier::TryTrain(frames, params)).value();
   const double train_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - train_start)
           .count();

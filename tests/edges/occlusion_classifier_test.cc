@@ -439,8 +439,15 @@ TEST(OcclusionClassifierIoTest, UntrainedRoundTripAndBadMagic) {
 TEST(OcclusionClassifierTrainTest, NoFramesIsAnError) {
   const Result<OcclusionClassifier> fitted = OcclusionClassifier::Fit({}, SmallForest());
   ASSERT_FALSE(fitted.ok());
-  EXPECT_NE(fitted.status().message().find("no usable"), std::string::npos);
-  EXPECT_FALSE(OcclusionClassifier::Train({}, SmallForest()).trained());
+  EXPECT_NE(fitted.status().message().find("no frames"), std::string::npos);
+}
+
+TEST(OcclusionClassifierTrainTest, FramesWithoutObstacleContoursAreAnError) {
+  SyntheticFrame s = MakeFrame(3);
+  s.frame.labels.setTo(1);  // one label everywhere: no contour to learn
+  const Result<OcclusionClassifier> fitted = OcclusionClassifier::Fit({s.frame}, SmallForest());
+  ASSERT_FALSE(fitted.ok());
+  EXPECT_NE(fitted.status().message().find("no obstacle contour"), std::string::npos);
 }
 
 TEST(OcclusionClassifierTrainTest, MismatchedLabelsNameTheFrame) {

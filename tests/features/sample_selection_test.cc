@@ -243,3 +243,27 @@ TEST(SampleSelectionTest, BadInputIsAnError) {
 
 }  // namespace
 }  // namespace tod
+
+namespace tod {
+namespace {
+
+// Without a road label (obstacle-mask benchmarks) `road` is every non-obstacle pixel: both
+// regressors draw their negatives from the same non-obstacle pool, independently.
+TEST(SampleSelectionTest, WithoutRoadLabelBothRegressorsDrawFromEveryNonObstacleBox) {
+  Sample gt = RoadWithOneObstacle();
+  gt.free_space = FreeSpace::kNotObstacle;
+  gt.road.setTo(255);
+  gt.road(gt.instances[0].box.rect()).setTo(0);
+  std::vector<ScoredBox> proposals;
+  for (int y = 0; y + 10 <= 100; y += 10)
+    for (int x = 0; x + 10 <= 100; x += 10) proposals.push_back({{x, y, 10, 10}, 0.1f});
+  auto selected = SelectTrainingSamples(proposals, gt, kLimits, SmallParams(), 3);
+  ASSERT_TRUE(selected.ok()) << selected.status().message();
+  const std::size_t positives = selected->positive_indices.size();
+  EXPECT_GT(selected->obdr_indices.size(), positives + 20);  // negatives despite no background
+  EXPECT_GT(selected->ordr_indices.size(), positives + 20);
+  EXPECT_NE(selected->ordr_indices, selected->obdr_indices);  // independent draws
+}
+
+}  // namespace
+}  // namespace tod

@@ -43,7 +43,7 @@ TEST(FrameGeometryTest, WiderAspectScalesByWidthAndKeepsRowsAboutTheCentre) {
   EXPECT_EQ(g.regions.image_width, 1920);
   EXPECT_EQ(g.regions.image_height, 1080);
   EXPECT_EQ(g.regions.layers[0], (Box{0, 435, 1920, 585}));  // 400*0.9375+60 = 435, clipped
-  EXPECT_EQ(g.regions.layers[1], (Box{480, 482, 960, 188}));
+  EXPECT_EQ(g.regions.layers[1], (Box{480, 481, 960, 189}));  // floor / ceil outward
   const SizeBand& b = g.size_filter.bands[0];
   EXPECT_DOUBLE_EQ(b.center_y_min, 412 * 0.9375 + 60);
   EXPECT_DOUBLE_EQ(b.h_max, 93.75);
@@ -57,7 +57,7 @@ TEST(FrameGeometryTest, SmallerFrameScalesEverythingByOneFactor) {
   EXPECT_EQ(g.regions.layers[1].x, 320);
   EXPECT_EQ(g.regions.layers[1].y, static_cast<int>(std::floor(450 * s + dy)));
   EXPECT_EQ(g.regions.layers[1].w, 640);
-  EXPECT_EQ(g.regions.layers[1].h, 125);
+  EXPECT_EQ(g.regions.layers[1].h, 126);
   for (const Box& r : g.regions.layers) {
     EXPECT_GE(r.x, 0);
     EXPECT_GE(r.y, 0);

@@ -41,12 +41,22 @@ class ModelBundleTest : public ::testing::Test {
     b.ordr = RandomForest::Train(x, y, fp);
     b.obdr = RandomForest::Train(x, y, fp);
     b.version = "test";
-    b.training = {{"data", "unit test"}};
+    // The occlusion classifier is left untrained here, which a bundle may only ship on purpose.
+    b.training = {{"data", "unit test"}, {"parts", {{"occlusion", {{"off", true}}}}}};
     return b;
   }
   std::string Path(const std::string& name = "model") const { return (dir_ / name).string(); }
   fs::path dir_;
 };
+
+TEST_F(ModelBundleTest, UntrainedOcclusionClassifierIsAnErrorUnlessSwitchedOff) {
+  ModelBundle b = SmallBundle(4);
+  b.training = {{"data", "unit test"}};
+  ASSERT_TRUE(SaveModelBundle(b, Path()).ok());
+  auto loaded = LoadModelBundle(Path());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.status().message().find("untrained"), std::string::npos);
+}
 
 TEST_F(ModelBundleTest, SaveLoadRoundTripKeepsEveryPart) {
   const ModelBundle b = SmallBundle(3);

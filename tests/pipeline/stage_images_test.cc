@@ -170,14 +170,17 @@ TEST_F(StageImagesTest, CountsDescribeEveryStageAndAddUpToTheDetectorsProposals)
   }
   EXPECT_GT(c["regions"][0]["edge_groups"].get<long long>(), 0);
   EXPECT_GT(total, 0);
-  EXPECT_EQ(c["proposals_total"].get<long long>(), total);
+  // The cross-region merge removes inner regions' copies of boxes: never more than the sum.
+  EXPECT_LE(c["proposals_total"].get<long long>(), total);
+  EXPECT_GT(c["proposals_total"].get<long long>(), 0);
   // The same stages as the detector: it regresses exactly these proposals.
   const ObstacleDetector detector(*bundle_, "tiny");
   DetectOptions options;
   options.max_proposals = 1 << 30;
   auto detection = detector.Detect(*frame_, options);
   ASSERT_TRUE(detection.ok());
-  EXPECT_EQ(static_cast<long long>(detection->proposals.size()), total);
+  EXPECT_EQ(static_cast<long long>(detection->proposals.size()),
+            c["proposals_total"].get<long long>());
 }
 
 TEST_F(StageImagesTest, ProposalPicturesDrawAtMostTheRequestedNumber) {

@@ -1,0 +1,144 @@
+// `tod train|eval|analyse --format masks` as a user of the obstacle benchmarks runs them: a masks
+// dataset (images/ + labels_masks/, {0, 1, 255}) is written from the CTest fixture's synthetic
+// frames, with JPEG and WebP frames, both mask file names, void and a split file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/run_command.h"
+#include "tests/test_env.h"
+
+namespace {
+namespace fs = std::filesystem;
+
+using tod::testing_env::CommandResult;
+using tod::testing_env::RunCommand;
+
+class MasksCliTest : public ::testing::Test {
+ protected:
+  // One dataset for the whole suite (training is the slow part).
+  static void SetUpTestSuite() {
+    root_ =
+        new fs::path(fs::temp_directory_path() / ("tod_masks_cli_" + std::to_string(::getpid())));
+    fs::remove_all(*root_);
+    fs::create_directories(*root_ / "images");
+    fs::create_directories(*root_ / "labels_masks");
+    std::ofstream split(*root_ / "split.txt");
+    int index = 0;
+    const fs::path data(tod::testing_env::TestData());
+    for (const char* part : {"train", "test"}) {
+      std::vector<fs::path> images;
+      for (const auto& e : fs::recursive_directory_iterator(data / "leftImg8bit" / part))
+        if (e.path().extension() == ".png") images.push_back(e.path());
+      std::sort(images.begin(), images.end());
+      for (const fs::path& image : images) {
+        const std::string stem = image.filename().string().substr(
+            0, image.filename().string().size() - std::string("_leftImg8bit.png").size());
+        const fs::path ids_path = data / "gtCoarse" / part / image.parent_path().filename() /
+                                  (stem + "_gtCoarse_instanceIds.png");
+        const cv::Mat ids = cv::imread(ids_path.string(), cv::IMREAD_UNCHANGED);
+        const cv::Mat bgr = cv::imread(image.string(), cv::IMREAD_COLOR);
+        if (ids.empty() || bgr.empty()) continue;
+        cv::Mat1b mask(ids.size(), uchar{0});
+        mask.setTo(1, ids > 1000);
+        mask.rowRange(mask.rows - 8, mask.rows).setTo(255);  // a void "hood"
+        const std::string name = std::to_string(index);
+        const char* extension = index % 3 == 0 ? ".jpg" : index % 3 == 1 ? ".webp" : ".png";
+        cv::imwrite((*root_ / "images" / (name + extension)).string(), bgr);
+        const std::string mask_name = index % 2 ? name + "_labels_semantic.png" : name + ".png";
+        cv::imwrite((*root_ / "labels_masks" / mask_name).string(), mask);
+        split << part << " " << name << "\n";
+        ++index;
+      }
+    }
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*root_);
+    delete root_;
+  }
+
+  void SetUp() override {
+    tod_ = tod::testing_env::BinDir() + "/tod";
+    ASSERT_TRUE(fs::exists(tod_));
+    out_ = *root_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::create_directories(out_);
+  }
+  std::string Root() const { return root_->string(); }
+  std::string Train(const std::string& model, const std::string& extra = "") const {
+    return tod_ + " train --data " + Root() + " --format masks --out " + model +
+           " --trees 10 --classifier-frames 6 --no-eval --threads 2 " + extra;
+  }
+
+  static fs::path* root_;
+  std::string tod_;
+  fs::path out_;
+};
+fs::path* MasksCliTest::root_ = nullptr;
+
+TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
+  const std::string model = (out_ / "model").string();
+  const CommandResult train = RunCommand(Train(model));
+  ASSERT_EQ(train.exit_code, 0) << train.output;
+  EXPECT_NE(train.output.find("peak RSS"), std::string::npos) << train.output;
+  std::ifstream manifest_in(fs::path(model) / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(manifest_in);
+  EXPECT_EQ(manifest["training"]["format"], "masks");
+  for (const char* part : {"edges", "occlusion", "ordr", "obdr", "calibration"})
+    EXPECT_EQ(manifest["training"]["parts"][part]["trained"], true) << part;
+  EXPECT_TRUE(manifest["params"]["obstacle_calibration"]["fitted"].get<bool>());
+  EXPECT_LT(manifest["params"]["prior_correction"]["occlusion_odds"].get<double>(), 1.0);
+
+  const std::string json = (out_ / "eval.json").string();
+  const CommandResult eval = RunCommand(tod_ + " eval --data " + Root() + " --split test --model " +
+                                        model + " --json " + json + " --threads 2");
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  EXPECT_NE(eval.output.find("no road label"), std::string::npos) << eval.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_GT(j["frames"].get<int>(), 0);
+  EXPECT_GT(j["instances"].get<int>(), 0);
+  EXPECT_TRUE(j["regression"]["BP+Fusion@4"].contains("ap"));
+  for (const char* key : {"false_alarms_per_frame", "false_alarms_per_obstacle_free_frame",
+                          "obstacle_free_frames", "instances_found"})
+    EXPECT_TRUE(j["obstacles"].contains(key)) << key;
+
+  const CommandResult analyse = RunCommand(tod_ + " analyse --data " + Root() +
+                                           " --split test --model " + model + " --threads 2");
+  ASSERT_EQ(analyse.exit_code, 0) << analyse.output;
+  EXPECT_NE(analyse.output.find("Where obstacles are lost"), std::string::npos);
+}
+
+TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
+  // A copy of the dataset with one corrupt test image.
+  const fs::path copy = out_ / "data";
+  fs::copy(*root_ / "images", copy / "images", fs::copy_options::recursive);
+  fs::copy(*root_ / "labels_masks", copy / "labels_masks", fs::copy_options::recursive);
+  fs::copy(*root_ / "split.txt", copy / "split.txt");
+  std::string victim;
+  for (const auto& e : fs::directory_iterator(copy / "images"))
+    if (e.path().stem() == "20" || victim.empty()) victim = e.path().string();
+  std::ofstream(victim, std::ios::trunc) << "not an image";
+  const std::string stem = fs::path(victim).stem().string();
+
+  const std::string model = (out_ / "model").string();
+  const CommandResult failed =
+      RunCommand(tod_ + " train --data " + copy.string() + " --split all --out " + model +
+                 " --trees 5 --classifier-frames 4 --no-eval");
+  EXPECT_NE(failed.exit_code, 0);
+  EXPECT_NE(failed.output.find("frame " + stem), std::string::npos) << failed.output;
+  EXPECT_FALSE(fs::exists(model));
+
+  const CommandResult skipped =
+      RunCommand(tod_ + " train --data " + copy.string() + " --split all --out " + model +
+                 " --trees 5 --classifier-frames 4 --no-eval --on-bad-frame skip --threads 2");
+  ASSERT_EQ(skipped.exit_code, 0) << skipped.output;
+  EXPECT_NE(skipped.output.find("skipped frame " + stem), std::string::npos) << skipped.output;
+  std::ifstream in(fs::path(model) / "manifest.json");
+  const nlohmann::json m = nlohmann::json::parse(in);
+  EXPECT_EQ(m["training"]["skipped_frames"]["count"], 1);
+}
+
+}  // namespace
