@@ -32,6 +32,9 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--format", args->train.format, "dataset format")
       ->check(CLI::IsMember({"auto", "laf", "masks", "modd2"}));
   cmd->add_option("--split", args->train.split, "split to train on");
+  cmd->add_option("--add-data", args->train.more_data,
+                  "another dataset to train on as well (repeatable; its format is detected, "
+                  "masks use its own split.txt), e.g. synthetic scenes beside real frames");
   cmd->add_option("--split-file", args->train.split_file,
                   "masks format: `train|test <stem>` lines to use instead of DATA/split.txt");
   cmd->add_option("--edge-source", args->train.edge_source, "base edge map")

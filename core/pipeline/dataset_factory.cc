@@ -65,4 +65,51 @@ Result<FrameSelection> SelectFrames(const DatasetSpec& spec) {
   return out;
 }
 
+namespace {
+
+// The frames of several selections, one after the other.
+class ConcatenatedDataset final : public Dataset {
+ public:
+  explicit ConcatenatedDataset(std::vector<FrameSelection> parts) : parts_(std::move(parts)) {
+    for (std::size_t p = 0; p < parts_.size(); ++p)
+      for (int frame : parts_[p].frames) index_.emplace_back(p, frame);
+  }
+  std::size_t size() const override { return index_.size(); }
+  std::string name(std::size_t i) const override {
+    if (i >= index_.size()) return {};
+    const auto& [part, frame] = index_[i];
+    return std::to_string(part) + ":" + parts_[part].dataset->name(frame);
+  }
+  Result<Sample> Load(std::size_t i) const override {
+    if (i >= index_.size())
+      return Status::InvalidArgument("frame index " + std::to_string(i) + " out of range");
+    const auto& [part, frame] = index_[i];
+    return parts_[part].dataset->Load(frame);
+  }
+
+ private:
+  std::vector<FrameSelection> parts_;
+  std::vector<std::pair<std::size_t, int>> index_;
+};
+
+}  // namespace
+
+Result<FrameSelection> SelectFrames(const std::vector<DatasetSpec>& specs) {
+  if (specs.empty()) return Status::InvalidArgument("no dataset given");
+  if (specs.size() == 1) return SelectFrames(specs.front());
+  std::vector<FrameSelection> parts;
+  std::string formats;
+  for (const DatasetSpec& spec : specs) {
+    auto part = SelectFrames(spec);
+    if (!part.ok()) return part.status();
+    formats += (formats.empty() ? "" : "+") + part->format;
+    parts.push_back(std::move(*part));
+  }
+  FrameSelection out;
+  out.format = formats;
+  out.dataset = std::make_unique<ConcatenatedDataset>(std::move(parts));
+  for (int i = 0; i < static_cast<int>(out.dataset->size()); ++i) out.frames.push_back(i);
+  return out;
+}
+
 }  // namespace tod

@@ -34,6 +34,9 @@ struct FrameSelection {
   std::vector<int> frames;  // indices into dataset, ascending, never empty
 };
 Result<FrameSelection> SelectFrames(const DatasetSpec& spec);
+// Several datasets as one (e.g. synthetic scenes and real frames): their selections in order;
+// frame names are prefixed with the dataset's position when there is more than one.
+Result<FrameSelection> SelectFrames(const std::vector<DatasetSpec>& specs);
 
 // "laf", "masks", "modd2", or an error naming what was looked for.
 Result<std::string> DetectDatasetFormat(const std::string& root);

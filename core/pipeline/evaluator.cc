@@ -91,10 +91,16 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
     const int layers = geo.regions.num_layers();
 
-    // Proposal-only variants on the plain (not obstacle-aware) occlusion edges.
+    // Proposal-only baselines on plain (not obstacle-aware) edges. OLP@1 must not run the
+    // occlusion classifier, which learned its features on enhanced edges Ê: it scores each
+    // superpixel boundary by its mean plain E instead (the untrained boundary strength of §3.4),
+    // so OLP@1 -> OAOCC+OLP@1 measures enhancement plus the trained obstacle-aware classifier.
+    const OcclusionClassifier untrained_boundaries;
+    PipelineParams plain_params = bundle.params;
+    plain_params.prior_correction.occlusion_odds = 1.0;  // mean E is no classifier probability
     const OcclusionEdges plain =
-        ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion, bundle.params,
-                              /*enhance=*/false);
+        ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &untrained_boundaries,
+                              plain_params, /*enhance=*/false);
     const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1, kMaxProposals);
     const ProposalSet olp1 = ProposeBoxes(
         plain, geo.regions, bundle.params.boxes,

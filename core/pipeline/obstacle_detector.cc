@@ -40,14 +40,29 @@ std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
   return out;
 }
 
+namespace {
+
+// The manifest's training data: one root, or several joined by " + ".
+std::string TrainedOn(const nlohmann::json& training) {
+  if (!training.is_object() || !training.contains("data")) return {};
+  const nlohmann::json& data = training["data"];
+  if (data.is_string()) return data.get<std::string>();
+  std::string joined;
+  if (data.is_array())
+    for (const auto& root : data)
+      if (root.is_string()) joined += (joined.empty() ? "" : " + ") + root.get<std::string>();
+  return joined;
+}
+
+}  // namespace
+
 ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
     : bundle_(std::move(bundle)) {
   info_.name = std::move(name);
   info_.version = bundle_.version;
   info_.format_version = kBundleFormatVersion;
   info_.created = bundle_.created;
-  info_.trained_on =
-      bundle_.training.is_object() ? bundle_.training.value("data", std::string()) : std::string();
+  info_.trained_on = TrainedOn(bundle_.training);
   info_.edge_source = bundle_.edge_kind;
   info_.manifest = {
       {"version", bundle_.version},          {"created", bundle_.created},

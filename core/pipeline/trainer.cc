@@ -35,8 +35,11 @@ class TrainingRun {
   explicit TrainingRun(const TrainOptions& options) : options_(options) {}
 
   Status Open() {
-    auto selection = SelectFrames({options_.data_root, options_.split, options_.format,
-                                   options_.split_file, options_.max_frames});
+    std::vector<DatasetSpec> specs = {{options_.data_root, options_.split, options_.format,
+                                       options_.split_file, options_.max_frames}};
+    for (const std::string& root : options_.more_data)
+      specs.push_back({root, options_.split, "auto", "", options_.max_frames});
+    auto selection = SelectFrames(specs);
     if (!selection.ok()) return selection.status();
     selection_ = std::move(*selection);
     frames_ = selection_.frames;
@@ -497,7 +500,9 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   const int n = static_cast<int>(survey->usable.size());
   nlohmann::json seconds = run.seconds();
   seconds["total"] = SecondsSince(run.started());
-  bundle.training = {{"data", options.data_root},
+  nlohmann::json data = nlohmann::json::array({options.data_root});
+  for (const std::string& root : options.more_data) data.push_back(root);
+  bundle.training = {{"data", options.more_data.empty() ? nlohmann::json(options.data_root) : data},
                      {"format", run.format()},
                      {"split", options.split},
                      {"frames", n},

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "core/edges/edge_source.h"
 #include "core/edges/occlusion_classifier.h"
@@ -22,7 +23,10 @@ struct TrainOptions {
   std::string data_root;
   std::string format = "auto";  // auto | laf | masks | modd2
   std::string split = "train";
-  std::string split_file;                    // masks: instead of <data_root>/split.txt
+  std::string split_file;  // masks: instead of <data_root>/split.txt
+  // More datasets trained on together with data_root (same split name; each its own format and
+  // split file), e.g. synthetic scenes beside real frames. Frames must share one size.
+  std::vector<std::string> more_data;
   std::string regions = "auto";              // auto (k-means on the training obstacles) | laf2020
   std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
   std::string sed_model;                     // model file for edge_source "sed"
