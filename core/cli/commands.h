@@ -14,6 +14,7 @@ Runner AddTrainCommand(CLI::App& app);
 Runner AddDetectCommand(CLI::App& app);
 Runner AddEvalCommand(CLI::App& app);
 Runner AddAnalyseCommand(CLI::App& app);
+Runner AddBenchCommand(CLI::App& app);
 
 // Prints "tod: <message>" to stderr and returns 1.
 int Fail(const std::string& message);

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   add(tod::cli::AddDetectCommand);
   add(tod::cli::AddEvalCommand);
   add(tod::cli::AddAnalyseCommand);
+  add(tod::cli::AddBenchCommand);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

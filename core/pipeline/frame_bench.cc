@@ -1,0 +1,260 @@
+#include "core/pipeline/frame_bench.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <mutex>
+#include <opencv2/imgcodecs.hpp>
+#include <optional>
+
+#include "core/pipeline/detection_output.h"
+#include "core/pipeline/edge_boxes_baseline.h"
+#include "core/pipeline/frame_geometry.h"
+#include "core/pipeline/frame_stages.h"
+#include "core/pipeline/obstacle_detector.h"
+#include "core/pipeline/parallel.h"
+
+namespace tod {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsBetween(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double, std::milli>(to - from).count();
+}
+
+constexpr int kEdgeBoxesMax = 1000;  // the baseline: 1000 boxes
+
+bool IsFrameFile(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".webp";
+}
+
+Result<std::vector<uchar>> ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound("cannot open " + path);
+  std::vector<uchar> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) return Status::DataLoss("cannot read " + path);
+  return bytes;
+}
+
+// The detector's stage names mapped onto the contract's (only probability_map differs).
+std::string ContractName(const std::string& detector_stage) {
+  return detector_stage == "probability_map" ? "map" : detector_stage;
+}
+
+// The work counters and the Edge Boxes baseline, on a separate pass with the detector's own
+// stage calls and parameters (ObstacleDetector::Detect), so the timed call carries no counting.
+void CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchRecord& record) {
+  const FrameGeometry geometry = GeometryForFrame(bundle, bgr.cols, bgr.rows);
+  const OcclusionEdges oaocc =
+      ComputeOcclusionEdges(bgr, geometry.regions, *bundle.edges, &bundle.occlusion, bundle.params,
+                            /*enhance=*/true);
+  const SizeFilter* size_filter = bundle.params.size_filter ? &geometry.size_filter : nullptr;
+  std::vector<std::vector<ScoredBox>> per_region;
+  for (int k = 0; k < geometry.regions.num_layers(); ++k) {
+    EdgeBoxStats stats;
+    per_region.push_back(ProposeRegionBoxes(oaocc, geometry.regions, bundle.params.boxes, k,
+                                            bundle.params.multistride, size_filter, &stats));
+    record.windows_scored += stats.windows_visited;
+    record.windows_walked += stats.windows_past_early_exit;
+    record.edge_groups += stats.edge_groups;
+    record.edge_pixels += stats.edge_pixels;
+  }
+  record.proposals = static_cast<long long>(
+      MergeRegionBoxes(per_region, bundle.params.region_merge_iou).boxes.size());
+
+  // E is the same map with or without the obstacle-aware enhancement, so the baseline scores
+  // exactly the base edges our proposals start from. Its time includes the orientation and the
+  // edge thinning it needs (edge_boxes_baseline.h), not the edge map itself.
+  const Clock::time_point start = Clock::now();
+  const std::vector<Box> boxes = EdgeBoxesBaseline(oaocc.base_edge, oaocc.r1, kEdgeBoxesMax);
+  record.edgeboxes_ms = MsBetween(start, Clock::now());
+  record.edgeboxes_boxes = static_cast<long long>(boxes.size());
+}
+
+// The timed part: decode, the detector's call exactly as `tod detect` makes it, and the map
+// encoded as `tod detect` writes it. The decoded frame is handed back for the counting pass; the
+// detection is released here, so its maps are not held while the counting pass runs.
+Result<FrameBenchRecord> TimeFrame(const ObstacleDetector& detector,
+                                   const std::vector<uchar>& bytes, const DetectOptions& options,
+                                   cv::Mat3b& bgr) {
+  const Clock::time_point start = Clock::now();
+  const cv::Mat decoded = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  const Clock::time_point decoded_at = Clock::now();
+  if (decoded.empty()) return Status::InvalidArgument("not a decodable image");
+  bgr = decoded;
+  const auto detection = detector.Detect(bgr, options);
+  if (!detection.ok()) return detection.status();
+  const Clock::time_point encode_start = Clock::now();
+  std::vector<uchar> png;
+  const bool encoded = cv::imencode(".png", ProbabilityTo8Bit(detection->probability), png);
+  const Clock::time_point end = Clock::now();
+  if (!encoded) return Status::Internal("cannot encode the probability map");
+
+  FrameBenchRecord record;
+  record.width = bgr.cols;
+  record.height = bgr.rows;
+  record.stages_ms.emplace_back("decode", MsBetween(start, decoded_at));
+  for (const auto& [stage, ms] : detection->timings)
+    record.stages_ms.emplace_back(ContractName(stage), ms);
+  record.stages_ms.emplace_back("encode_map", MsBetween(encode_start, end));
+  record.stages_ms.emplace_back("total", MsBetween(start, end));
+  return record;
+}
+
+Result<FrameBenchRecord> MeasureFrame(const ObstacleDetector& detector, const std::string& path,
+                                      const DetectOptions& options) {
+  // Reading the file is the storage's time, not ours: done before the clock starts.
+  const auto bytes = ReadBytes(path);
+  if (!bytes.ok()) return bytes.status();
+  cv::Mat3b bgr;
+  auto record = TimeFrame(detector, *bytes, options, bgr);
+  if (!record.ok()) return record.status();
+  record->frame = path;
+  CountWork(detector.bundle(), bgr, *record);
+  return record;
+}
+
+// The contract's stages in its order, then any stage the detector adds later (in pipeline order),
+// total last. A contract stage no record has (a renamed detector stage) is left out rather than
+// reported as 0 ms, so the JSON misses its key and the CLI test says so.
+std::vector<std::string> StageOrder(const std::vector<FrameBenchRecord>& records) {
+  const auto recorded = [&](const std::string& stage) {
+    for (const FrameBenchRecord& r : records)
+      for (const auto& [name, ms] : r.stages_ms)
+        if (name == stage) return true;
+    return false;
+  };
+  const std::vector<std::string>& contract = BenchStageNames();
+  const auto in_contract = [&](const std::string& stage) {
+    return std::find(contract.begin(), contract.end(), stage) != contract.end();
+  };
+  std::vector<std::string> order;
+  for (const std::string& stage : contract)
+    if (stage != "total" && recorded(stage)) order.push_back(stage);
+  for (const FrameBenchRecord& r : records)
+    for (const auto& [stage, ms] : r.stages_ms)
+      if (!in_contract(stage) && std::find(order.begin(), order.end(), stage) == order.end())
+        order.push_back(stage);
+  order.push_back("total");
+  return order;
+}
+
+}  // namespace
+
+const std::vector<std::string>& BenchStageNames() {
+  static const std::vector<std::string> kNames = {
+      "decode",   "edges",      "superpixels", "occlusion",  "proposals",
+      "features", "regression", "map",         "encode_map", "total"};
+  return kNames;
+}
+
+Result<std::vector<std::string>> ListBenchFrames(const std::string& dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return Status::NotFound("no directory " + dir);
+  std::vector<std::string> frames;
+  for (auto it = std::filesystem::recursive_directory_iterator(dir, ec);
+       !ec && it != std::filesystem::recursive_directory_iterator(); it.increment(ec))
+    if (it->is_regular_file(ec) && IsFrameFile(it->path())) frames.push_back(it->path().string());
+  if (ec) return Status::NotFound("cannot list " + dir + ": " + ec.message());
+  std::sort(frames.begin(), frames.end());
+  return frames;
+}
+
+Spread SpreadOf(std::vector<double> values) {
+  Spread s;
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  s.median = n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  const auto rank = static_cast<std::size_t>(std::ceil(0.9 * static_cast<double>(n)));
+  s.p90 = values[std::clamp<std::size_t>(rank, 1, n) - 1];
+  s.max = values.back();
+  return s;
+}
+
+double PeakRssMb() {
+  rusage usage{};
+  if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
+
+Result<FrameBenchReport> RunFrameBench(const ObstacleDetector& detector,
+                                       const std::vector<std::string>& frames,
+                                       const BenchOptions& options) {
+  if (frames.empty()) return Status::InvalidArgument("no frames to measure");
+  DetectOptions detect = options.detect;
+  detect.want_probability_map = true;  // encode_map is part of every frame
+  // The first frame pays for faulting in the heap, the model's pages and OpenCV's lazy setup;
+  // its numbers would describe a cold process, not a running service.
+  if (options.warm_up) (void)MeasureFrame(detector, frames.front(), detect);
+
+  const int n = static_cast<int>(frames.size());
+  std::vector<std::optional<FrameBenchRecord>> measured(frames.size());
+  std::mutex progress_mutex;
+  int done = 0;
+  const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
+    auto record = MeasureFrame(detector, frames[i], detect);
+    if (!record.ok()) return record.status();
+    measured[i] = std::move(*record);
+    if (options.progress) {
+      std::lock_guard lock(progress_mutex);
+      const double total = measured[i]->stages_ms.back().second;
+      options.progress("frame " + std::to_string(++done) + "/" + std::to_string(n) + " " +
+                       frames[i] + ": " + std::to_string(std::lround(total)) + " ms");
+    }
+    return Status::Ok();
+  });
+
+  FrameBenchReport report;
+  report.model = detector.info().name;
+  report.threads = options.threads;
+  const Status bad = ApplyBadFramePolicy(
+      per_frame, [&](int i) { return frames[i]; }, BadFramePolicy::kSkip, &report.skipped);
+  if (!bad.ok()) return bad;
+  for (auto& r : measured)
+    if (r) report.records.push_back(std::move(*r));
+  if (report.records.empty())
+    return Status::InvalidArgument(
+        "no frame could be measured (first: " + report.skipped.front().frame + ": " +
+        report.skipped.front().reason + ")");
+
+  for (const std::string& stage : StageOrder(report.records)) {
+    std::vector<double> values;
+    for (const FrameBenchRecord& r : report.records)
+      for (const auto& [name, ms] : r.stages_ms)
+        if (name == stage) values.push_back(ms);
+    report.stages_ms.emplace_back(stage, SpreadOf(std::move(values)));
+  }
+  std::vector<double> edgeboxes;
+  for (const FrameBenchRecord& r : report.records) edgeboxes.push_back(r.edgeboxes_ms);
+  report.edgeboxes_ms = SpreadOf(std::move(edgeboxes));
+  const std::vector<std::pair<std::string, long long FrameBenchRecord::*>> counters = {
+      {"windows_scored", &FrameBenchRecord::windows_scored},
+      {"windows_walked", &FrameBenchRecord::windows_walked},
+      {"edge_groups", &FrameBenchRecord::edge_groups},
+      {"edge_pixels", &FrameBenchRecord::edge_pixels},
+      {"proposals", &FrameBenchRecord::proposals}};
+  for (const auto& [name, field] : counters) {
+    std::vector<double> values;
+    for (const FrameBenchRecord& r : report.records)
+      values.push_back(static_cast<double>(r.*field));
+    report.counters.emplace_back(name, SpreadOf(std::move(values)));
+  }
+  for (const auto& [stage, spread] : report.stages_ms)
+    if (stage == "proposals" && spread.median > 0)
+      report.edgeboxes_ratio = report.edgeboxes_ms.median / spread.median;
+  report.peak_rss_mb = PeakRssMb();
+  return report;
+}
+
+}  // namespace tod
