@@ -17,8 +17,8 @@ cv::Mat3b DrawOverlay(const cv::Mat3b& image, const tod::v1::DetectResponse& res
   for (const tod::v1::Proposal& p : response.proposals())
     detection.proposals.push_back({FromProto(p.box()), p.fused(), p.ordr(), p.obdr()});
   for (const tod::v1::Obstacle& o : response.obstacles())
-    detection.obstacles.push_back(
-        {FromProto(o.box()), o.area(), o.peak_probability(), o.mean_probability()});
+    detection.obstacles.push_back({FromProto(o.box()), o.area(), o.peak_probability(),
+                                   o.mean_probability(), o.evidence(), o.score()});
   if (!probability.empty() && probability.size() == image.size())
     probability.convertTo(detection.probability, CV_32F, 1.0 / 255.0);
   return tod::DrawOverlay(image, detection, style.proposals_drawn);

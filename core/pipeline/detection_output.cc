@@ -71,7 +71,7 @@ cv::Mat3b DrawOverlay(const cv::Mat3b& bgr, const Detection& d, int top_proposal
   for (const DetectedObstacle& o : d.obstacles) {
     cv::rectangle(out, o.box.rect(), {0, 255, 255}, std::max(1, static_cast<int>(2 * scale)));
     char label[32];
-    std::snprintf(label, sizeof label, "%.2f", o.peak_probability);
+    std::snprintf(label, sizeof label, "%.2f", o.score);  // calibrated: P(obstacle)
     cv::putText(out, label, {o.box.x, std::max(12, o.box.y - 4)}, cv::FONT_HERSHEY_SIMPLEX,
                 0.5 * scale + 0.2, {0, 255, 255}, 1, cv::LINE_AA);
   }
