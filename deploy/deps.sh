@@ -15,10 +15,13 @@ BUILD_PACKAGES=(
   libboost-dev libjpeg62-turbo-dev libpng-dev
   libcpp-httplib-dev
   libgtest-dev libgmock-dev
+  clang libclang-rt-14-dev
 )
 # libboost-dev: Boost.Beast/Asio (header-only) for tod_server's REST transport.
 # libjpeg62-turbo-dev, libpng-dev: tod_server's strict image decoders.
 # libcpp-httplib-dev: only the HTTP client of tod_load and of the tests (not the server).
+# clang, libclang-rt-14-dev: the libFuzzer targets (tests/fuzz/; libFuzzer and the sanitizer
+# runtimes of Debian 12's clang 14). The production build stays on gcc.
 
 RUNTIME_PACKAGES=(
   ca-certificates tini
