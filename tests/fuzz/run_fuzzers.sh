@@ -84,7 +84,11 @@ for target in $targets; do
   dict=()
   [[ -f tests/fuzz/dict/$target.dict ]] && dict=(-dict="tests/fuzz/dict/$target.dict")
   log=$BUILD_DIR/$target.log
-  echo "run_fuzzers.sh: $target: ${runs:+$runs runs, at most $max_time s}${runs:-$seconds s}"
+  if [[ -n $runs ]]; then
+    echo "run_fuzzers.sh: $target: $runs runs (time limit: ${max_time} s, 0 = none)"
+  else
+    echo "run_fuzzers.sh: $target: $seconds s"
+  fi
   status=0
   nice "$BUILD_DIR/bin/$target" "${common[@]}" "${limit[@]}" "${dict[@]}" \
     -artifact_prefix="$artifacts" "$work" "tests/fuzz/corpus/$target" >"$log" 2>&1 || status=$?
