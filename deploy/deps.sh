@@ -11,14 +11,18 @@ BUILD_PACKAGES=(
   libopencv-dev libopencv-contrib-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libeigen3-dev libspdlog-dev libfmt-dev nlohmann-json3-dev libcli11-dev
-  prometheus-cpp-dev libmatio-dev
+  prometheus-cpp-dev libmatio-dev zlib1g-dev
   libboost-dev libjpeg62-turbo-dev libpng-dev
   libcpp-httplib-dev
   libgtest-dev libgmock-dev
+  clang libclang-rt-14-dev
 )
 # libboost-dev: Boost.Beast/Asio (header-only) for tod_server's REST transport.
 # libjpeg62-turbo-dev, libpng-dev: tod_server's strict image decoders.
+# zlib1g-dev: the MAT file bounds check inflates compressed variables (core/modd2/mat5_bounds.cc).
 # libcpp-httplib-dev: only the HTTP client of tod_load and of the tests (not the server).
+# clang, libclang-rt-14-dev: the libFuzzer targets (tests/fuzz/; libFuzzer and the sanitizer
+# runtimes of Debian 12's clang 14). The production build stays on gcc.
 
 RUNTIME_PACKAGES=(
   ca-certificates tini

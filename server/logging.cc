@@ -2,6 +2,7 @@
 
 #include <spdlog/sinks/stdout_sinks.h>
 
+#include <algorithm>
 #include <atomic>
 
 namespace tod::server {
@@ -17,8 +18,11 @@ std::string Dump(const nlohmann::json& value) {
 std::string TextValue(const nlohmann::json& value) {
   if (value.is_string()) {
     const std::string& text = value.get_ref<const std::string&>();
-    // Quote values with spaces so key=value stays splittable.
-    return text.find(' ') == std::string::npos ? text : Dump(nlohmann::json(text));
+    // Quote (JSON-escape) values with spaces or control characters, so key=value stays
+    // splittable and a client's text (a frame_id of "%0A...") cannot start a forged log line.
+    const bool plain = std::none_of(text.begin(), text.end(),
+                                    [](unsigned char c) { return c <= ' ' || c == 0x7f; });
+    return plain ? text : Dump(nlohmann::json(text));
   }
   return Dump(value);
 }

@@ -7,10 +7,13 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/modd2/mat5_bounds.h"
 #include "core/modd2/modd2_reader.h"
 
 namespace tod {
@@ -173,6 +176,19 @@ Result<Modd2Annotation> ReadModd2Annotation(const std::string& mat_path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(mat_path, ec)) {
     return Status::NotFound(mat_path + ": annotation file not found");
+  }
+  // libmatio allocates whatever sizes the file claims: check them first (mat5_bounds.h).
+  {
+    const auto bytes = std::filesystem::file_size(mat_path, ec);
+    if (ec) return Status::NotFound(mat_path + ": cannot read the annotation file");
+    if (bytes > kMaxMatFileBytes) {
+      return Status::DataLoss(mat_path + ": " + std::to_string(bytes) +
+                              " bytes is too large for an annotation file");
+    }
+    std::ifstream in(mat_path, std::ios::binary);
+    const std::string contents((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
+    if (Status bounds = CheckMat5Bounds(contents, mat_path); !bounds.ok()) return bounds;
   }
   const MatFile mat(Mat_Open(mat_path.c_str(), MAT_ACC_RDONLY));
   if (!mat) return Status::DataLoss(mat_path + ": not a readable MAT file");

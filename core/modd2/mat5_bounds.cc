@@ -1,0 +1,188 @@
+#include "core/modd2/mat5_bounds.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace tod {
+namespace {
+
+// MAT-File Level 5 data types and array classes used here (MathWorks' MAT-file format document).
+constexpr uint32_t kMiInt32 = 5;
+constexpr uint32_t kMiMatrix = 14;
+constexpr uint32_t kMiCompressed = 15;
+constexpr uint32_t kClassCell = 1;
+constexpr uint32_t kClassStruct = 2;
+constexpr uint32_t kClassObject = 3;
+constexpr uint32_t kClassSparse = 5;
+constexpr uint32_t kLastNumericClass = 15;  // mxUINT64_CLASS
+constexpr int kMaxDepth = 32;
+
+class Walker {
+ public:
+  Walker(bool swap, std::string what) : swap_(swap), what_(std::move(what)) {}
+
+  // A sequence of data elements (the file after its header, or an inflated variable).
+  Status Elements(std::string_view data, bool top_level) {
+    while (data.size() >= 8) {
+      uint32_t type = 0;
+      uint32_t size = 0;
+      std::string_view payload;
+      if (Status s = Tag(&data, &type, &size, &payload); !s.ok()) return s;
+      if (type == kMiCompressed && top_level) {
+        std::string inflated;
+        if (Status s = Inflate(payload, &inflated); !s.ok()) return s;
+        if (Status s = Elements(inflated, false); !s.ok()) return s;
+      } else if (type == kMiMatrix) {
+        if (Status s = Matrix(payload, 0); !s.ok()) return s;
+      }
+    }
+    return Status::Ok();
+  }
+
+ private:
+  uint32_t U32(const char* p) const {
+    const auto* b = reinterpret_cast<const unsigned char*>(p);
+    return swap_ ? (uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | b[3]
+                 : (uint32_t{b[3]} << 24) | (uint32_t{b[2]} << 16) | (uint32_t{b[1]} << 8) | b[0];
+  }
+
+  Status Corrupt(const std::string& problem) const {
+    return Status::DataLoss(what_ + ": not a valid MAT file (" + problem + ")");
+  }
+
+  // One data element from the front of `data`: its type, byte count and payload (the small
+  // format packs up to 4 bytes into the tag). Advances past the 8-byte padding.
+  Status Tag(std::string_view* data, uint32_t* type, uint32_t* size,
+             std::string_view* payload) const {
+    if (data->size() < 8) return Corrupt("truncated element tag");
+    const uint32_t first = U32(data->data());
+    if ((first >> 16) != 0) {  // small data element
+      *type = first & 0xFFFF;
+      *size = first >> 16;
+      if (*size > 4) return Corrupt("small element of more than 4 bytes");
+      *payload = data->substr(4, *size);
+      data->remove_prefix(8);
+      return Status::Ok();
+    }
+    *type = first;
+    *size = U32(data->data() + 4);
+    if (*size > data->size() - 8) return Corrupt("element larger than its container");
+    *payload = data->substr(8, *size);
+    // Compressed elements are not padded; the others are padded to 8 bytes (if room is left).
+    const size_t padded = *type == kMiCompressed ? *size : (size_t{*size} + 7) / 8 * 8;
+    data->remove_prefix(std::min(data->size(), 8 + padded));
+    return Status::Ok();
+  }
+
+  Status Inflate(std::string_view in, std::string* out) const {
+    z_stream z{};
+    if (inflateInit(&z) != Z_OK) return Status::Internal("zlib inflateInit failed");
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
+    z.avail_in = static_cast<uInt>(in.size());
+    std::vector<char> chunk(1 << 16);
+    int result = Z_OK;
+    while (result == Z_OK) {
+      z.next_out = reinterpret_cast<Bytef*>(chunk.data());
+      z.avail_out = static_cast<uInt>(chunk.size());
+      result = inflate(&z, Z_NO_FLUSH);
+      out->append(chunk.data(), chunk.size() - z.avail_out);
+      if (out->size() > kMaxMatFileBytes) {
+        inflateEnd(&z);
+        return Corrupt("a compressed variable inflates to more than " +
+                       std::to_string(kMaxMatFileBytes) + " bytes");
+      }
+      if (result == Z_BUF_ERROR && z.avail_in == 0) break;  // truncated: matio reports it
+    }
+    inflateEnd(&z);
+    return Status::Ok();
+  }
+
+  // A miMATRIX payload: array flags, dimensions, name, then the class's own subelements.
+  Status Matrix(std::string_view data, int depth) {
+    if (depth > kMaxDepth) return Corrupt("arrays nested more than 32 deep");
+    if (data.empty()) return Status::Ok();  // an empty matrix element (allowed in cells)
+    const size_t own_bytes = data.size();
+    uint32_t type = 0, size = 0;
+    std::string_view flags, dims, name;
+    if (Status s = Tag(&data, &type, &size, &flags); !s.ok()) return s;
+    if (flags.size() < 4) return Corrupt("array flags too short");
+    const uint32_t array_class = U32(flags.data()) & 0xFF;
+    // Classes past the numeric ones (opaque, function handles) have no dimensions subelement.
+    if (array_class > kLastNumericClass) return Status::Ok();
+    if (Status s = Tag(&data, &type, &size, &dims); !s.ok()) return s;
+    if (type != kMiInt32 || dims.size() < 8 || dims.size() % 4 != 0) {
+      return Corrupt("array dimensions are not two or more int32 values");
+    }
+    uint64_t elements = 1;
+    for (size_t at = 0; at < dims.size(); at += 4) {
+      const int32_t d = static_cast<int32_t>(U32(dims.data() + at));
+      if (d < 0) return Corrupt("negative array dimension");
+      // Saturates instead of overflowing; any product this large is refused below anyway.
+      elements =
+          d == 0 ? 0 : (elements > (uint64_t{1} << 40) / d ? uint64_t{1} << 40 : elements * d);
+    }
+    if (Status s = Tag(&data, &type, &size, &name); !s.ok()) return s;
+    if (array_class == kClassSparse) return Status::Ok();  // stored by non-zeros, not by dims
+    if (array_class != kClassStruct && array_class != kClassObject && array_class != kClassCell) {
+      // Numeric or char: every element takes at least one stored byte.
+      if (elements > own_bytes) {
+        return Corrupt("an array claims " + std::to_string(elements) + " elements in " +
+                       std::to_string(own_bytes) + " bytes");
+      }
+      return Status::Ok();
+    }
+    uint64_t fields = 1;
+    if (array_class != kClassCell) {
+      std::string_view class_name, name_length, names;
+      if (array_class == kClassObject) {
+        if (Status s = Tag(&data, &type, &size, &class_name); !s.ok()) return s;
+      }
+      if (Status s = Tag(&data, &type, &size, &name_length); !s.ok()) return s;
+      if (name_length.size() < 4) return Corrupt("struct field name length missing");
+      const uint32_t length = U32(name_length.data());
+      if (Status s = Tag(&data, &type, &size, &names); !s.ok()) return s;
+      fields = length == 0 ? 0 : names.size() / length;
+    }
+    // Each element of each field is a miMATRIX element of at least its 8-byte tag.
+    if (elements * fields > own_bytes / 8) {
+      return Corrupt("a struct or cell array claims " + std::to_string(elements) + " x " +
+                     std::to_string(fields) + " values in " + std::to_string(own_bytes) + " bytes");
+    }
+    for (uint64_t i = 0; i < elements * fields && !data.empty(); ++i) {
+      std::string_view child;
+      if (Status s = Tag(&data, &type, &size, &child); !s.ok()) return s;
+      if (type != kMiMatrix) return Corrupt("a struct or cell value is not an array");
+      if (Status s = Matrix(child, depth + 1); !s.ok()) return s;
+    }
+    return Status::Ok();
+  }
+
+  bool swap_;
+  std::string what_;
+};
+
+}  // namespace
+
+Status CheckMat5Bounds(std::string_view bytes, const std::string& what) {
+  if (bytes.size() > kMaxMatFileBytes) {
+    return Status::DataLoss(what + ": " + std::to_string(bytes.size()) +
+                            " bytes is too large for an annotation file");
+  }
+  // Header: 116 bytes of text, 8 of subsystem offset, version (2 bytes), endian indicator "IM"
+  // (little-endian file) or "MI". Anything else (v4, v7.3/HDF5) is left to libmatio.
+  if (bytes.size() < 128) return Status::Ok();
+  const std::string_view endian = bytes.substr(126, 2);
+  if (endian != "IM" && endian != "MI") return Status::Ok();
+  const bool swap = endian == "MI";
+  const auto* v = reinterpret_cast<const unsigned char*>(bytes.data() + 124);
+  const unsigned version = swap ? (v[0] << 8) | v[1] : (v[1] << 8) | v[0];
+  if (version != 0x0100) return Status::Ok();
+  return Walker(swap, what).Elements(bytes.substr(128), true);
+}
+
+}  // namespace tod
