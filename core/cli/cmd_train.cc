@@ -32,6 +32,8 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--format", args->train.format, "dataset format")
       ->check(CLI::IsMember({"auto", "laf", "masks", "modd2"}));
   cmd->add_option("--split", args->train.split, "split to train on");
+  cmd->add_option("--data-terms", args->train.data_terms,
+                  "the training data's terms of use, recorded in the manifest");
   cmd->add_option("--add-data", args->train.more_data,
                   "another dataset to train on as well (repeatable; its format is detected, "
                   "masks use its own split.txt), e.g. synthetic scenes beside real frames");

@@ -504,6 +504,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   for (const std::string& root : options.more_data) data.push_back(root);
   bundle.training = {{"data", options.more_data.empty() ? nlohmann::json(options.data_root) : data},
                      {"format", run.format()},
+                     {"data_terms", options.data_terms},
                      {"split", options.split},
                      {"frames", n},
                      {"skipped_frames", SkippedFramesToJson(survey->skipped)},

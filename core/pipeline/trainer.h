@@ -27,7 +27,8 @@ struct TrainOptions {
   // More datasets trained on together with data_root (same split name; each its own format and
   // split file), e.g. synthetic scenes beside real frames. Frames must share one size.
   std::vector<std::string> more_data;
-  std::string regions = "auto";              // auto (k-means on the training obstacles) | laf2020
+  std::string data_terms;        // the training data's terms of use, recorded in the manifest
+  std::string regions = "auto";  // auto (k-means on the training obstacles) | laf2020
   std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
   std::string sed_model;                     // model file for edge_source "sed"
   std::uint64_t seed = 1;
