@@ -419,7 +419,19 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
   for (const auto& frame : per_frame)
     for (const auto& [e, label] : frame) evidence.push_back(e), labels.push_back(label);
   auto fitted = FitObstacleCalibration(evidence, labels);
-  if (!fitted.ok()) return fitted.status().WithContext("calibrating obstacle scores");
+  if (!fitted.ok()) {
+    // Not an untrained learned part but data without the contrast to fit (e.g. a handful of
+    // frames on which every component is an obstacle): said here and recorded, and the bundle's
+    // scores stay the raw evidence, as documented for uncalibrated bundles.
+    run.Say("obstacle scores NOT calibrated: " + fitted.status().message() +
+            "; obstacles report their raw evidence as score");
+    bundle.params.obstacle_calibration = ObstacleCalibration{};
+    parts["calibration"] = {{"learned", true},
+                            {"trained", false},
+                            {"reason", fitted.status().message()},
+                            {"components", evidence.size()}};
+    return Status::Ok();
+  }
   bundle.params.obstacle_calibration = *fitted;
   parts["calibration"] = {{"learned", true},
                           {"trained", true},

@@ -142,7 +142,9 @@ TEST_F(CliTest, DetectStagesWritesEveryStageAsAFrameSizedPngAndTheCounts) {
     kept += region["proposals_kept"].get<long long>();
   }
   EXPECT_GT(kept, 0);
-  EXPECT_EQ(j["proposals_total"].get<long long>(), kept);
+  // After the cross-region merge: at most the regions' sum (inner regions repeat R1's boxes).
+  EXPECT_LE(j["proposals_total"].get<long long>(), kept);
+  EXPECT_GT(j["proposals_total"].get<long long>(), 0);
 }
 
 TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {

@@ -114,6 +114,7 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
 TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
   // A copy of the dataset with one corrupt test image.
   const fs::path copy = out_ / "data";
+  fs::create_directories(copy);
   fs::copy(*root_ / "images", copy / "images", fs::copy_options::recursive);
   fs::copy(*root_ / "labels_masks", copy / "labels_masks", fs::copy_options::recursive);
   fs::copy(*root_ / "split.txt", copy / "split.txt");
