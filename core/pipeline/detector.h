@@ -2,6 +2,7 @@
 // const and thread-safe. This is the only header the server and the CLI need.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -18,6 +19,11 @@ struct DetectOptions {
   int max_proposals = 100;          // proposals returned (the map always uses all of them)
   float obstacle_threshold = 0.5f;  // obstacle mask = P > threshold
   bool want_probability_map = true;
+  // Asked between stages (after edges, superpixels, occlusion, proposals, features, regression);
+  // when it returns a non-OK Status (Cancelled, DeadlineExceeded, ...) Detect stops and returns
+  // it. A stage itself is never interrupted, so the hook only has to be cheap and thread-safe.
+  // Empty: run to the end.
+  std::function<Status()> cancelled;
 };
 
 struct Proposal {
