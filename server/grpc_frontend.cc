@@ -24,9 +24,14 @@ std::optional<std::chrono::steady_clock::time_point> SteadyDeadline(
 }
 
 // Why gRPC cancelled the call: its deadline passed, or the client cancelled (or went away).
+// The client's own deadline timer fires before the server's (the server counts from when the
+// request arrived), and its cancellation then reaches the server first; so a cancellation this
+// close to the deadline is the deadline's.
+constexpr std::chrono::seconds kDeadlineSlack(1);
 CancelReason CallCancelReason(const grpc::CallbackServerContext& context) {
-  return context.deadline() <= std::chrono::system_clock::now() ? CancelReason::kDeadline
-                                                                : CancelReason::kClientCancelled;
+  return context.deadline() - kDeadlineSlack <= std::chrono::system_clock::now()
+             ? CancelReason::kDeadline
+             : CancelReason::kClientCancelled;
 }
 
 // Unary Detect: like the default reactor, plus OnCancel, which stops the request's work at its

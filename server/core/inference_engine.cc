@@ -262,6 +262,10 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
   }
   result.timings.insert(result.timings.end(), result.detection.timings.begin(),
                         result.detection.timings.end());
+  // The last boundary: a caller that gave up during the final stage gets no OK either.
+  if (const std::optional<CancelReason> reason = StopReason(cancellation, request.deadline)) {
+    return Stopped(*reason, "after the pipeline ran");
+  }
 
   if (request.encode_map_png && !result.detection.probability.empty()) {
     const Clock::time_point encode_start = Clock::now();
