@@ -3,6 +3,7 @@
 //   tod_client stream --addr HOST:PORT IMAGE|FOLDER ... [--out DIR]   all images on one stream
 //   tod_client info   --addr HOST:PORT                                 model info as JSON
 //   tod_client health --addr HOST:PORT [--service NAME]                exit 0 iff SERVING
+// Every command takes --tls-ca FILE (TLS), --tls-cert/--tls-key (mutual TLS) and --token-file.
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <iostream>
@@ -56,7 +57,36 @@ bool Report(const DetectArgs& args, const std::string& path, const std::string& 
   return true;
 }
 
-int RunDetect(const std::string& addr, const DetectArgs& args, bool as_stream) {
+// The connection flags every command shares.
+struct ConnectionArgs {
+  std::string tls_ca;
+  std::string tls_cert;
+  std::string tls_key;
+  std::string token_file;
+};
+
+void AddConnectionOptions(CLI::App* command, ConnectionArgs* args) {
+  command->add_option("--tls-ca", args->tls_ca, "PEM CA of the server's certificate: use TLS");
+  command->add_option("--tls-cert", args->tls_cert, "PEM client certificate (mutual TLS)");
+  command->add_option("--tls-key", args->tls_key, "PEM key of --tls-cert");
+  command->add_option("--token-file", args->token_file,
+                      "File whose first line is the bearer token to send");
+}
+
+// A client for `addr`, or nullopt (with the reason printed) when a flag's file is unusable.
+std::optional<tod::client::TodGrpcClient> Connect(const std::string& addr,
+                                                  const ConnectionArgs& args) {
+  auto options =
+      tod::client::LoadConnectionOptions(args.tls_ca, args.tls_cert, args.tls_key, args.token_file);
+  if (!options.ok()) {
+    std::cerr << "tod_client: " << options.status().message() << "\n";
+    return std::nullopt;
+  }
+  return std::optional<tod::client::TodGrpcClient>(std::in_place, addr, std::move(*options));
+}
+
+int RunDetect(const std::string& addr, const ConnectionArgs& connection, const DetectArgs& args,
+              bool as_stream) {
   auto images = tod::client::CollectImages(args.inputs);
   if (!images.ok()) {
     std::cerr << "tod_client: " << images.status().message() << "\n";
@@ -71,7 +101,9 @@ int RunDetect(const std::string& addr, const DetectArgs& args, bool as_stream) {
     }
     bytes.push_back(std::move(*read));
   }
-  tod::client::TodGrpcClient client(addr);
+  std::optional<tod::client::TodGrpcClient> connected = Connect(addr, connection);
+  if (!connected) return 2;
+  tod::client::TodGrpcClient& client = *connected;
   bool all_ok = true;
   if (as_stream) {
     std::vector<tod::v1::DetectRequest> requests;
@@ -111,10 +143,11 @@ int RunDetect(const std::string& addr, const DetectArgs& args, bool as_stream) {
   return all_ok ? 0 : 1;
 }
 
-int RunInfo(const std::string& addr) {
-  tod::client::TodGrpcClient client(addr);
+int RunInfo(const std::string& addr, const ConnectionArgs& connection) {
+  std::optional<tod::client::TodGrpcClient> client = Connect(addr, connection);
+  if (!client) return 2;
   tod::v1::ModelInfo info;
-  const grpc::Status status = client.GetModelInfo(&info);
+  const grpc::Status status = client->GetModelInfo(&info);
   if (!status.ok()) {
     std::cerr << "tod_client: GetModelInfo failed: " << status.error_code() << " "
               << status.error_message() << "\n";
@@ -125,10 +158,12 @@ int RunInfo(const std::string& addr) {
 }
 
 // Exit 0 when SERVING, 1 otherwise (Docker HEALTHCHECK reserves other codes).
-int RunHealth(const std::string& addr, const std::string& service) {
-  tod::client::TodGrpcClient client(addr);
+int RunHealth(const std::string& addr, const ConnectionArgs& connection,
+              const std::string& service) {
+  std::optional<tod::client::TodGrpcClient> client = Connect(addr, connection);
+  if (!client) return 1;  // not 2: Docker's HEALTHCHECK reserves it
   grpc::health::v1::HealthCheckResponse response;
-  const grpc::Status status = client.Health(service, &response);
+  const grpc::Status status = client->Health(service, &response);
   if (!status.ok()) {
     std::cout << "UNREACHABLE " << status.error_code() << " " << status.error_message() << "\n";
     return 1;
@@ -158,6 +193,7 @@ int main(int argc, char** argv) {
   DetectArgs detect_args;
   DetectArgs stream_args;
   std::string service;
+  ConnectionArgs connection;
 
   CLI::App* detect = app.add_subcommand("detect", "Detect obstacles, one request per image");
   AddDetectOptions(detect, &addr, &detect_args);
@@ -169,9 +205,13 @@ int main(int argc, char** argv) {
   health->add_option("--addr", addr, "Server gRPC address HOST:PORT")->required();
   health->add_option("--service", service, "Service name (default: whole server)");
 
+  for (CLI::App* command : {detect, stream, info, health}) {
+    AddConnectionOptions(command, &connection);
+  }
+
   CLI11_PARSE(app, argc, argv);
-  if (*detect) return RunDetect(addr, detect_args, /*as_stream=*/false);
-  if (*stream) return RunDetect(addr, stream_args, /*as_stream=*/true);
-  if (*info) return RunInfo(addr);
-  return RunHealth(addr, service);
+  if (*detect) return RunDetect(addr, connection, detect_args, /*as_stream=*/false);
+  if (*stream) return RunDetect(addr, connection, stream_args, /*as_stream=*/true);
+  if (*info) return RunInfo(addr, connection);
+  return RunHealth(addr, connection, service);
 }

@@ -37,6 +37,11 @@ struct LoadArgs {
   std::string json_path;
   std::string map = "none";
   int timeout_ms = 30000;
+  std::string tls_ca;  // TLS (HTTPS / gRPC over TLS) when set
+  std::string tls_cert;
+  std::string tls_key;
+  std::string token_file;
+  tod::client::ConnectionOptions connection;  // the files above, read
 };
 
 struct Image {
@@ -50,7 +55,16 @@ class Sender {
  public:
   Sender(const LoadArgs& args, tod::client::TodGrpcClient* grpc) : args_(args), grpc_(grpc) {
     if (args.http) {
-      http_ = std::make_unique<httplib::Client>("http://" + args.addr);
+      const tod::client::ConnectionOptions& connection = args.connection;
+      if (connection.tls_ca_file.empty()) {
+        http_ = std::make_unique<httplib::Client>("http://" + args.addr);
+      } else {
+        http_ = std::make_unique<httplib::Client>("https://" + args.addr, connection.tls_cert_file,
+                                                  connection.tls_key_file);
+        http_->set_ca_cert_path(connection.tls_ca_file.c_str());
+        http_->enable_server_certificate_verification(true);
+      }
+      if (!connection.token.empty()) http_->set_bearer_token_auth(connection.token.c_str());
       http_->set_read_timeout(std::chrono::milliseconds(args.timeout_ms));
       http_->set_write_timeout(std::chrono::milliseconds(args.timeout_ms));
       http_->set_keep_alive(true);
@@ -100,6 +114,8 @@ class Sender {
         return "UNAVAILABLE";
       case grpc::StatusCode::INTERNAL:
         return "INTERNAL";
+      case grpc::StatusCode::UNAUTHENTICATED:
+        return "UNAUTHENTICATED";
       default:
         return std::string("CODE_") + std::to_string(static_cast<int>(code));
     }
@@ -134,7 +150,19 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"png", "none"}));
   app.add_option("--timeout-ms", args.timeout_ms, "Per-request timeout (default 30000)")
       ->check(CLI::Range(1, 3600000));
+  app.add_option("--tls-ca", args.tls_ca, "PEM CA of the server's certificate: use TLS");
+  app.add_option("--tls-cert", args.tls_cert, "PEM client certificate (mutual TLS)");
+  app.add_option("--tls-key", args.tls_key, "PEM key of --tls-cert");
+  app.add_option("--token-file", args.token_file,
+                 "File whose first line is the bearer token to send");
   CLI11_PARSE(app, argc, argv);
+  auto connection =
+      tod::client::LoadConnectionOptions(args.tls_ca, args.tls_cert, args.tls_key, args.token_file);
+  if (!connection.ok()) {
+    std::cerr << "tod_load: " << connection.status().message() << "\n";
+    return 2;
+  }
+  args.connection = std::move(*connection);
   const bool open_loop = args.rate > 0;
   if (open_loop && concurrency->count() == 0) args.concurrency = 64;
 
@@ -153,7 +181,7 @@ int main(int argc, char** argv) {
     images.push_back({path, std::move(*bytes), tod::client::ContentTypeFor(path)});
   }
 
-  tod::client::TodGrpcClient grpc_client(args.addr);
+  tod::client::TodGrpcClient grpc_client(args.addr, args.connection);
   const Clock::time_point start = Clock::now();
   const Clock::time_point measure_from =
       start + std::chrono::microseconds(static_cast<long long>(args.warmup_s * 1e6));

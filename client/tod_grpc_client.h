@@ -11,15 +11,31 @@
 #include <string>
 #include <vector>
 
+#include "core/base/status.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "tod/v1/obstacle_discovery.grpc.pb.h"
 
 namespace tod::client {
 
+// How to reach a server that runs TLS and/or bearer tokens. Empty fields: plaintext, no token.
+struct ConnectionOptions {
+  std::string tls_ca_file;    // PEM CA that signed the server's certificate: connect over TLS
+  std::string tls_cert_file;  // PEM client certificate and key, for servers that require mTLS
+  std::string tls_key_file;
+  std::string token;  // sent as "authorization: Bearer <token>"
+};
+
+// Reads the flags' files (--tls-ca, --tls-cert, --tls-key, --token-file: the first non-empty,
+// non-comment line of the token file) into ConnectionOptions; errors name the file.
+tod::Result<ConnectionOptions> LoadConnectionOptions(const std::string& tls_ca_file,
+                                                     const std::string& tls_cert_file,
+                                                     const std::string& tls_key_file,
+                                                     const std::string& token_file);
+
 class TodGrpcClient {
  public:
-  // address: "host:port"; plaintext channel sized for large frames and maps.
-  explicit TodGrpcClient(const std::string& address);
+  // address: "host:port"; a channel sized for large frames and maps, TLS when options say so.
+  explicit TodGrpcClient(const std::string& address, ConnectionOptions options = {});
 
   grpc::Status Detect(const tod::v1::DetectRequest& request, tod::v1::DetectResponse* response,
                       std::optional<std::chrono::milliseconds> timeout = std::nullopt);
@@ -34,6 +50,11 @@ class TodGrpcClient {
                       std::chrono::milliseconds timeout = std::chrono::seconds(5));
 
  private:
+  // A context carrying the token (if any) and, when given, a deadline `timeout` from now.
+  void Prepare(grpc::ClientContext* context,
+               std::optional<std::chrono::milliseconds> timeout) const;
+
+  std::string token_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<tod::v1::ObstacleDiscovery::Stub> stub_;
   std::unique_ptr<grpc::health::v1::Health::Stub> health_;

@@ -12,17 +12,21 @@ BUILD_PACKAGES=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libeigen3-dev libspdlog-dev libfmt-dev nlohmann-json3-dev libcli11-dev
   prometheus-cpp-dev libmatio-dev zlib1g-dev
-  libboost-dev libjpeg62-turbo-dev libpng-dev
+  libboost-dev libjpeg62-turbo-dev libpng-dev libssl-dev
   libcpp-httplib-dev
   libgtest-dev libgmock-dev
   clang libclang-rt-14-dev
+  openssl stress-ng
 )
 # libboost-dev: Boost.Beast/Asio (header-only) for tod_server's REST transport.
 # libjpeg62-turbo-dev, libpng-dev: tod_server's strict image decoders.
+# libssl-dev: TLS of tod_server's REST transport (Boost.Asio's ssl::stream) and token digests.
 # zlib1g-dev: the MAT file bounds check inflates compressed variables (core/modd2/mat5_bounds.cc).
 # libcpp-httplib-dev: only the HTTP client of tod_load and of the tests (not the server).
 # clang, libclang-rt-14-dev: the libFuzzer targets (tests/fuzz/; libFuzzer and the sanitizer
 # runtimes of Debian 12's clang 14). The production build stays on gcc.
+# openssl: the service tests make a throw-away CA and certificates with the openssl command.
+# stress-ng: loads the CPUs beside the service tests to check they hold on a busy machine.
 
 RUNTIME_PACKAGES=(
   ca-certificates tini
@@ -30,10 +34,11 @@ RUNTIME_PACKAGES=(
   libopencv-contrib406
   libgrpc++1.51 libgrpc29 libprotobuf32
   libspdlog1.10 libfmt9 libprometheus-cpp-core1.0 libmatio11
-  libjpeg62-turbo libpng16-16
+  libjpeg62-turbo libpng16-16 libssl3
   libcpp-httplib0.11
 )
 # libcpp-httplib0.11: tod_load's HTTP client; tod_server does not load it.
+# libssl3: OpenSSL for tod_server's HTTPS (gRPC carries its own TLS in libgrpc29).
 
 usage() {
   echo "usage: $0 build|runtime|--print [build|runtime]" >&2

@@ -57,6 +57,14 @@ const std::vector<SettingSpec>& SettingSpecs() {
        "Seconds a REST connection may wait idle for its next request (default 60)"},
       {"http_write_timeout_s", "http-write-timeout", "TOD_HTTP_WRITE_TIMEOUT",
        "Seconds allowed for writing one response (default 30)"},
+      {"tls_cert", "tls-cert", "TOD_TLS_CERT",
+       "PEM certificate chain: serve gRPC and HTTPS over TLS (with --tls-key)"},
+      {"tls_key", "tls-key", "TOD_TLS_KEY", "PEM private key of --tls-cert"},
+      {"tls_client_ca", "tls-client-ca", "TOD_TLS_CLIENT_CA",
+       "PEM CA certificates: require client certificates it signed (mutual TLS)"},
+      {"auth_token_file", "auth-token-file", "TOD_AUTH_TOKEN_FILE",
+       "Bearer tokens, one a line (reloaded on SIGHUP): Detect, DetectStream, GetModelInfo and "
+       "/v1/* need 'authorization: Bearer <token>'"},
       {"log_format", "log-format", "TOD_LOG_FORMAT", "text | json (default text)"},
       {"log_level", "log-level", "TOD_LOG_LEVEL", "trace|debug|info|warn|error (default info)"},
   };
@@ -102,6 +110,14 @@ Status ApplySetting(const std::string& key, const std::string& value, const std:
     return ParseNumber(value, what, &config->http_idle_timeout_s);
   } else if (key == "http_write_timeout_s") {
     return ParseNumber(value, what, &config->http_write_timeout_s);
+  } else if (key == "tls_cert") {
+    config->tls_cert = value;
+  } else if (key == "tls_key") {
+    config->tls_key = value;
+  } else if (key == "tls_client_ca") {
+    config->tls_client_ca = value;
+  } else if (key == "auth_token_file") {
+    config->auth_token_file = value;
   } else if (key == "log_format") {
     config->log_format = value;
   } else if (key == "log_level") {
@@ -221,6 +237,12 @@ Status ValidateServerConfig(const ServerConfig& config) {
       return Status::InvalidArgument(std::string(name) + ": must be in 0.1..3600 seconds");
     }
   }
+  if (config.tls_cert.empty() != config.tls_key.empty()) {
+    return Status::InvalidArgument("tls_cert and tls_key: give both or neither");
+  }
+  if (!config.tls_client_ca.empty() && config.tls_cert.empty()) {
+    return Status::InvalidArgument("tls_client_ca: needs tls_cert and tls_key");
+  }
   if (config.log_format != "text" && config.log_format != "json") {
     return Status::InvalidArgument("log_format: '" + config.log_format + "' is not text or json");
   }
@@ -251,6 +273,10 @@ nlohmann::json ServerConfigToJson(const ServerConfig& config) {
           {"http_request_timeout_s", config.http_request_timeout_s},
           {"http_idle_timeout_s", config.http_idle_timeout_s},
           {"http_write_timeout_s", config.http_write_timeout_s},
+          {"tls_cert", config.tls_cert},
+          {"tls_key", config.tls_key},
+          {"tls_client_ca", config.tls_client_ca},
+          {"auth_token_file", config.auth_token_file},
           {"log_format", config.log_format},
           {"log_level", config.log_level}};
 }

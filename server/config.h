@@ -35,8 +35,14 @@ struct ServerConfig {
   double http_request_timeout_s = 30;  // first byte to last body byte of one request
   double http_idle_timeout_s = 60;     // connection without a request in progress
   double http_write_timeout_s = 30;    // writing one response
-  std::string log_format = "text";     // text | json
-  std::string log_level = "info";      // trace | debug | info | warn | error
+  // TLS on both listeners (both files, or neither); a client CA turns on mutual TLS.
+  std::string tls_cert;
+  std::string tls_key;
+  std::string tls_client_ca;
+  // Bearer tokens, one a line, reloaded on SIGHUP; empty: no authentication.
+  std::string auth_token_file;
+  std::string log_format = "text";  // text | json
+  std::string log_level = "info";   // trace | debug | info | warn | error
 };
 
 // Absolute pixel ceiling no configuration may exceed (decompression-bomb guard).

@@ -74,7 +74,8 @@ void FillModelInfo(const LoadedModel& model, tod::v1::ModelInfo* info) {
   info->set_trained_on(bundle.trained_on);
   info->set_edge_source(bundle.edge_source);
   info->set_manifest_json(bundle.manifest.dump());
-  info->set_model_dir(model.model_dir);
+  // The bundle's name only: the server's filesystem layout is nobody's business on the wire.
+  info->set_model_dir(bundle.name);
   info->set_generation(model.generation);
   info->set_loaded_at(model.loaded_at);
 }

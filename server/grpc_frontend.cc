@@ -23,6 +23,33 @@ std::optional<std::chrono::steady_clock::time_point> SteadyDeadline(
          std::chrono::duration_cast<std::chrono::steady_clock::duration>(remaining);
 }
 
+// Why gRPC cancelled the call: its deadline passed, or the client cancelled (or went away).
+// The client's own deadline timer fires before the server's (the server counts from when the
+// request arrived), and its cancellation then reaches the server first; so a cancellation this
+// close to the deadline is the deadline's.
+constexpr std::chrono::seconds kDeadlineSlack(1);
+CancelReason CallCancelReason(const grpc::CallbackServerContext& context) {
+  return context.deadline() - kDeadlineSlack <= std::chrono::system_clock::now()
+             ? CancelReason::kDeadline
+             : CancelReason::kClientCancelled;
+}
+
+// Unary Detect: like the default reactor, plus OnCancel, which stops the request's work at its
+// next stage boundary. The reactor owns itself (the callback API's model) and is deleted in
+// OnDone, after Finish; the Cancellation is shared with the engine's job.
+class DetectReactor final : public grpc::ServerUnaryReactor {
+ public:
+  DetectReactor(const grpc::CallbackServerContext& context,
+                std::shared_ptr<Cancellation> cancellation)
+      : context_(context), cancellation_(std::move(cancellation)) {}
+  void OnCancel() override { cancellation_->Cancel(CallCancelReason(context_)); }
+  void OnDone() override { delete this; }
+
+ private:
+  const grpc::CallbackServerContext& context_;
+  const std::shared_ptr<Cancellation> cancellation_;
+};
+
 // One frame at a time per stream: read, run, write, read the next. Responses therefore come back
 // in request order, and a stream holds at most one queue slot.
 class DetectStreamReactor final
@@ -33,6 +60,9 @@ class DetectStreamReactor final
     StartRead(&request_);
   }
 
+  // The whole stream is cancelled: the frame running (if any) stops at its next stage boundary.
+  void OnCancel() override { cancellation_->Cancel(CallCancelReason(*context_)); }
+
   void OnReadDone(bool ok) override {
     if (!ok) {  // the client closed its side (or the call broke): nothing pending, done
       Finish(grpc::Status::OK);
@@ -42,7 +72,8 @@ class DetectStreamReactor final
     // Advance before submitting: the completion may run (and start the next read) at once.
     const long long index = frame_index_++;
     service_.SubmitFrame(
-        context_, request_, std::to_string(index), &response_, [this, index](grpc::Status status) {
+        context_, request_, std::to_string(index), cancellation_, &response_,
+        [this, index](grpc::Status status) {
           if (!status.ok()) {
             Finish(grpc::Status(status.error_code(), std::string("frame ") + std::to_string(index) +
                                                          ": " + status.error_message()));
@@ -68,14 +99,42 @@ class DetectStreamReactor final
   grpc::ByteBuffer request_;
   grpc::ByteBuffer response_;
   long long frame_index_ = 0;
+  const std::shared_ptr<Cancellation> cancellation_ = std::make_shared<Cancellation>();
+};
+
+// A stream refused before its first read (no valid token).
+class RefusedStreamReactor final
+    : public grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer> {
+ public:
+  explicit RefusedStreamReactor(const grpc::Status& status) { Finish(status); }
+  void OnDone() override { delete this; }
 };
 
 }  // namespace
 
 ObstacleDiscoveryService::ObstacleDiscoveryService(InferenceEngine& engine,
                                                    const ModelHolder& models,
-                                                   ServerMetrics& metrics)
-    : engine_(engine), models_(models), metrics_(metrics) {}
+                                                   ServerMetrics& metrics,
+                                                   std::shared_ptr<const TokenAuthenticator> auth)
+    : engine_(engine), models_(models), metrics_(metrics), auth_(std::move(auth)) {}
+
+std::optional<grpc::Status> ObstacleDiscoveryService::Refuse(
+    const grpc::CallbackServerContext& context, const char* method) {
+  if (!auth_) return std::nullopt;
+  const auto& metadata = context.client_metadata();
+  const auto header = metadata.find("authorization");
+  const std::string_view value =
+      header == metadata.end() ? std::string_view()
+                               : std::string_view(header->second.data(), header->second.size());
+  const std::optional<std::string> refused = auth_->Check(value);
+  if (!refused) return std::nullopt;
+  metrics_.RecordRejection("unauthenticated");
+  metrics_.RecordRequest("grpc", "UNAUTHENTICATED", 0);
+  LogEvent(
+      spdlog::level::warn, "unauthenticated",
+      {{"protocol", "grpc"}, {"method", method}, {"peer", context.peer()}, {"error", *refused}});
+  return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, *refused);
+}
 
 std::string ObstacleDiscoveryService::NextRequestId() {
   return std::string("g") + std::to_string(++request_counter_);
@@ -84,18 +143,21 @@ std::string ObstacleDiscoveryService::NextRequestId() {
 void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
                                            const grpc::ByteBuffer& request_bytes,
                                            const std::string& default_frame_id,
+                                           std::shared_ptr<Cancellation> cancellation,
                                            grpc::ByteBuffer* response,
                                            std::function<void(grpc::Status)> done) {
   const std::string request_id = NextRequestId();
   const std::string peer = context->peer();
   auto log = [this, request_id, peer](const std::string& frame_id, size_t bytes,
-                                      const grpc::Status& status, double ms) {
+                                      const grpc::Status& status, double ms,
+                                      const char* cancelled = nullptr) {
     const std::string code = GrpcCodeName(status.error_code());
     metrics_.RecordRequest("grpc", code, ms / 1000.0);
     nlohmann::json fields = {{"id", request_id}, {"protocol", "grpc"}, {"frame", frame_id},
                              {"peer", peer},     {"bytes", bytes},     {"status", code},
                              {"ms", ms}};
     if (!status.ok()) fields["error"] = status.error_message();
+    if (cancelled != nullptr) fields["cancelled"] = cancelled;
     LogEvent(status.ok() ? spdlog::level::info : spdlog::level::warn, "detect", fields);
   };
 
@@ -115,6 +177,7 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
   inference.options = options.detect;
   inference.encode_map_png = options.encode_map_png;
   inference.deadline = SteadyDeadline(*context);
+  inference.cancellation = std::move(cancellation);
   const std::string frame_id = !request->frame_id().empty() ? request->frame_id()
                                : !default_frame_id.empty()  ? default_frame_id
                                                             : request_id;
@@ -126,7 +189,8 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
       FillDetectResponse(result, frame_id, &message);
       status = ToGrpcStatus(SerializeMessage(message, response));
     }
-    log(frame_id, request->image().size(), status, result.total_ms);
+    log(frame_id, request->image().size(), status, result.total_ms,
+        result.cancelled ? CancelReasonName(*result.cancelled) : nullptr);
     done(status);
   });
 }
@@ -134,21 +198,35 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
 grpc::ServerUnaryReactor* ObstacleDiscoveryService::Detect(grpc::CallbackServerContext* context,
                                                            const grpc::ByteBuffer* request,
                                                            grpc::ByteBuffer* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  SubmitFrame(context, *request, "", response,
+  if (std::optional<grpc::Status> refused = Refuse(*context, "Detect")) {
+    grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+    reactor->Finish(*refused);
+    return reactor;
+  }
+  auto cancellation = std::make_shared<Cancellation>();
+  auto* reactor = new DetectReactor(*context, cancellation);  // deletes itself in OnDone
+  SubmitFrame(context, *request, "", std::move(cancellation), response,
               [reactor](grpc::Status status) { reactor->Finish(status); });
   return reactor;
 }
 
 grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* ObstacleDiscoveryService::DetectStream(
     grpc::CallbackServerContext* context) {
-  return new DetectStreamReactor(*this, context);  // deletes itself in OnDone
+  // Both reactors delete themselves in OnDone.
+  if (std::optional<grpc::Status> refused = Refuse(*context, "DetectStream")) {
+    return new RefusedStreamReactor(*refused);
+  }
+  return new DetectStreamReactor(*this, context);
 }
 
 grpc::ServerUnaryReactor* ObstacleDiscoveryService::GetModelInfo(
     grpc::CallbackServerContext* context, const grpc::ByteBuffer* request,
     grpc::ByteBuffer* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  if (std::optional<grpc::Status> refused = Refuse(*context, "GetModelInfo")) {
+    reactor->Finish(*refused);
+    return reactor;
+  }
   grpc::Status status;
   tod::v1::GetModelInfoRequest parsed;
   const std::shared_ptr<const LoadedModel> model = models_.Current();

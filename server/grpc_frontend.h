@@ -8,11 +8,15 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string>
 
+#include "server/core/cancellation.h"
 #include "server/core/inference_engine.h"
 #include "server/core/model_holder.h"
 #include "server/metrics.h"
+#include "server/token_auth.h"
 #include "tod/v1/obstacle_discovery.grpc.pb.h"
 
 namespace tod::server {
@@ -24,9 +28,12 @@ using RawObstacleDiscoveryService = tod::v1::ObstacleDiscovery::WithRawCallbackM
 
 class ObstacleDiscoveryService final : public RawObstacleDiscoveryService {
  public:
-  // All three must outlive the service.
+  // All three must outlive the service. With `auth`, every method needs the call metadata
+  // "authorization: Bearer <token>" (UNAUTHENTICATED otherwise); grpc.health.v1 and reflection
+  // are other services and stay open.
   ObstacleDiscoveryService(InferenceEngine& engine, const ModelHolder& models,
-                           ServerMetrics& metrics);
+                           ServerMetrics& metrics,
+                           std::shared_ptr<const TokenAuthenticator> auth = nullptr);
 
   grpc::ServerUnaryReactor* Detect(grpc::CallbackServerContext* context,
                                    const grpc::ByteBuffer* request,
@@ -38,16 +45,22 @@ class ObstacleDiscoveryService final : public RawObstacleDiscoveryService {
                                          grpc::ByteBuffer* response) override;
 
   // Parses and submits one frame; `done` gets the status and, when OK, the serialised
-  // DetectResponse in `response`. `done` may run inline or on a worker thread.
+  // DetectResponse in `response`. `done` may run inline or on a worker thread. The call's
+  // reactor cancels `cancellation` when gRPC cancels the call.
   void SubmitFrame(grpc::CallbackServerContext* context, const grpc::ByteBuffer& request,
-                   const std::string& default_frame_id, grpc::ByteBuffer* response,
-                   std::function<void(grpc::Status)> done);
+                   const std::string& default_frame_id, std::shared_ptr<Cancellation> cancellation,
+                   grpc::ByteBuffer* response, std::function<void(grpc::Status)> done);
   std::string NextRequestId();
 
  private:
+  // UNAUTHENTICATED (logged and counted) when auth is on and the call has no valid token.
+  std::optional<grpc::Status> Refuse(const grpc::CallbackServerContext& context,
+                                     const char* method);
+
   InferenceEngine& engine_;
   const ModelHolder& models_;
   ServerMetrics& metrics_;
+  const std::shared_ptr<const TokenAuthenticator> auth_;
   std::atomic<uint64_t> request_counter_{0};
 };
 

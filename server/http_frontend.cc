@@ -117,6 +117,7 @@ class RestApi {
     }
     InferenceRequest inference;
     inference.image = request->message.body();
+    inference.cancellation = request->client_gone;
     std::string frame_id = request_id;
     if (Status s =
             ParseDetectQuery(http::ParseQuery(request->message.target()), &inference, &frame_id);
@@ -183,9 +184,22 @@ HttpFrontend::HttpFrontend(HttpFrontendConfig config, InferenceEngine& engine,
               {"error", refusal.message}});
   };
   observer.on_open_connections = [this](int open) { metrics_.SetHttpConnections(open); };
+  http::HttpServerOptions options;
+  options.limits = config_.limits;
+  options.io_threads = config_.io_threads;
+  options.retry_after_s = config_.retry_after_s;
+  options.tls = config_.tls;
+  if (config_.auth) {
+    options.authorizer = [auth = config_.auth](const http::Request& header) {
+      // Probes (/v2/health/*) and scrapers (/metrics) stay open; the API needs a token.
+      if (http::TargetPath(header.target()).rfind("/v1/", 0) != 0) {
+        return std::optional<std::string>();
+      }
+      return auth->Check(header[field::authorization]);
+    };
+  }
   server_ =
-      std::make_unique<http::HttpServer>(config_.limits, config_.io_threads, config_.retry_after_s,
-                                         api_->Routes(), std::move(observer));
+      std::make_unique<http::HttpServer>(std::move(options), api_->Routes(), std::move(observer));
 }
 
 HttpFrontend::~HttpFrontend() { Stop(); }
@@ -196,6 +210,6 @@ int HttpFrontend::port() const { return server_->port(); }
 
 void HttpFrontend::Start() { server_->Start(); }
 
-void HttpFrontend::Stop() { server_->Stop(); }
+void HttpFrontend::Stop(std::chrono::milliseconds grace) { server_->Stop(grace); }
 
 }  // namespace tod::server

@@ -8,10 +8,13 @@
 //   GET  /v1/model                                                   -> ModelInfo JSON
 //   GET  /v2/health/live, /v2/health/ready, /metrics
 //
-// No handler blocks an I/O thread: detection answers from the engine's completion.
+// No handler blocks an I/O thread: detection answers from the engine's completion. A client that
+// disconnects while its detection runs cancels it (the transport's client_gone).
 #pragma once
 
 #include <atomic>
+#include <boost/asio/ssl/context.hpp>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -21,6 +24,7 @@
 #include "server/core/model_holder.h"
 #include "server/http/http_limits.h"
 #include "server/metrics.h"
+#include "server/token_auth.h"
 
 namespace tod::server {
 
@@ -33,6 +37,10 @@ struct HttpFrontendConfig {
   http::HttpLimits limits;  // limits.max_body_bytes is the image byte limit
   int retry_after_s = 1;
   int io_threads = 2;
+  std::shared_ptr<boost::asio::ssl::context> tls;  // HTTPS when set
+  // When set, /v1/* need a bearer token (checked from the header, before the body is read);
+  // /v2/health/* and /metrics stay open for probes and scrapers.
+  std::shared_ptr<const TokenAuthenticator> auth;
 };
 
 class HttpFrontend {
@@ -48,8 +56,8 @@ class HttpFrontend {
   int port() const;
   // Serves on the I/O threads until Stop().
   void Start();
-  // Stops accepting, lets answers being written finish (a few seconds at most), closes.
-  void Stop();
+  // Stops accepting, lets answers being written finish (up to `grace`), closes.
+  void Stop(std::chrono::milliseconds grace = std::chrono::seconds(5));
 
  private:
   const HttpFrontendConfig config_;

@@ -2,6 +2,8 @@
 
 #include <prometheus/text_serializer.h>
 
+#include "server/core/cancellation.h"
+
 namespace tod::server {
 namespace {
 
@@ -45,6 +47,11 @@ ServerMetrics::ServerMetrics()
                       .Name("tod_rejections_total")
                       .Help("Requests refused, by reason")
                       .Register(*registry_)),
+      cancelled_(prometheus::BuildCounter()
+                     .Name("tod_requests_cancelled_total")
+                     .Help("Requests whose work was stopped at a stage boundary or skipped in "
+                           "the queue, by reason")
+                     .Register(*registry_)),
       http_refused_(prometheus::BuildCounter()
                         .Name("tod_http_refused_total")
                         .Help("Requests or connections the HTTP front end refused, by reason")
@@ -61,7 +68,15 @@ ServerMetrics::ServerMetrics()
       reloads_(prometheus::BuildCounter()
                    .Name("tod_model_reloads_total")
                    .Help("Model reload attempts by result")
-                   .Register(*registry_)) {}
+                   .Register(*registry_)),
+      token_reloads_(prometheus::BuildCounter()
+                         .Name("tod_auth_token_reloads_total")
+                         .Help("Bearer token file reloads (SIGHUP) by result")
+                         .Register(*registry_)) {
+  // Every reason from the start, so dashboards and alerts see 0 rather than no series.
+  for (const CancelReason reason : kAllCancelReasons)
+    cancelled_.Add({{"reason", CancelReasonName(reason)}});
+}
 
 void ServerMetrics::RecordRequest(const std::string& protocol, const std::string& code,
                                   double seconds) {
@@ -71,6 +86,10 @@ void ServerMetrics::RecordRequest(const std::string& protocol, const std::string
 
 void ServerMetrics::RecordRejection(const std::string& reason) {
   rejections_.Add({{"reason", reason}}).Increment();
+}
+
+void ServerMetrics::RecordCancelled(const std::string& reason) {
+  cancelled_.Add({{"reason", reason}}).Increment();
 }
 
 void ServerMetrics::RecordHttpRefusal(const std::string& reason) {
@@ -102,6 +121,10 @@ void ServerMetrics::SetModel(const std::string& name, const std::string& version
 
 void ServerMetrics::RecordReload(bool ok) {
   reloads_.Add({{"result", ok ? "success" : "failure"}}).Increment();
+}
+
+void ServerMetrics::RecordTokenReload(bool ok) {
+  token_reloads_.Add({{"result", ok ? "success" : "failure"}}).Increment();
 }
 
 std::string ServerMetrics::SerializeText() const {

@@ -25,6 +25,9 @@ class ServerMetrics {
   // A request refused before or instead of running: "queue_full", "too_large", "bad_image",
   // "not_ready", "deadline", "bad_request".
   void RecordRejection(const std::string& reason);
+  // A request whose work was stopped or skipped because its caller gave up or the drain timeout
+  // came: "deadline", "client_cancelled", "client_disconnected", "drain" (CancelReasonName).
+  void RecordCancelled(const std::string& reason);
   void ObserveQueueWait(double seconds);
   void ObserveStages(const StageTimes& stages);  // milliseconds in, seconds exported
   void SetQueueDepth(double depth);
@@ -34,6 +37,7 @@ class ServerMetrics {
   void SetHttpConnections(double open);
   void SetModel(const std::string& name, const std::string& version, int generation);
   void RecordReload(bool ok);
+  void RecordTokenReload(bool ok);
 
   std::string SerializeText() const;
 
@@ -46,10 +50,12 @@ class ServerMetrics {
   prometheus::Gauge& queue_depth_;
   prometheus::Gauge& in_flight_;
   prometheus::Family<prometheus::Counter>& rejections_;
+  prometheus::Family<prometheus::Counter>& cancelled_;
   prometheus::Family<prometheus::Counter>& http_refused_;
   prometheus::Gauge& http_connections_;
   prometheus::Family<prometheus::Gauge>& model_info_;
   prometheus::Family<prometheus::Counter>& reloads_;
+  prometheus::Family<prometheus::Counter>& token_reloads_;
   std::mutex model_mutex_;                     // guards model_series_
   prometheus::Gauge* model_series_ = nullptr;  // the one tod_model_info series (registry owns it)
 };

@@ -4,10 +4,15 @@
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
 
+#include <algorithm>
+#include <condition_variable>
 #include <csignal>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
 
 #include "server/core/inference_engine.h"
 #include "server/core/model_holder.h"
@@ -16,6 +21,8 @@
 #include "server/http_frontend.h"
 #include "server/logging.h"
 #include "server/metrics.h"
+#include "server/tls_config.h"
+#include "server/token_auth.h"
 
 namespace tod::server {
 namespace {
@@ -62,6 +69,45 @@ http::HttpLimits HttpLimitsFrom(const ServerConfig& config) {
   return limits;
 }
 
+// The drain deadline is a hard limit: if shutting down still hangs (a pipeline stage that does not
+// return, a front end that does not close) when `when` comes, the process exits anyway. Disarmed
+// when it goes out of scope.
+class ExitDeadline {
+ public:
+  explicit ExitDeadline(std::chrono::steady_clock::time_point when)
+      : thread_([this, when] {
+          std::unique_lock lock(mutex_);
+          if (disarmed_.wait_until(lock, when, [this] { return done_; })) return;
+          LogEvent(spdlog::level::err, "drain hard limit reached: exiting with work still running");
+          spdlog::default_logger()->flush();
+          std::_Exit(1);
+        }) {}
+  ~ExitDeadline() {
+    {
+      std::lock_guard lock(mutex_);
+      done_ = true;
+    }
+    disarmed_.notify_all();
+    thread_.join();
+  }
+  ExitDeadline(const ExitDeadline&) = delete;
+  ExitDeadline& operator=(const ExitDeadline&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable disarmed_;
+  bool done_ = false;
+  std::thread thread_;  // last: starts after the members it uses
+};
+
+// What is left of `budget` until `limit`, at least 0.
+std::chrono::milliseconds Within(std::chrono::milliseconds budget,
+                                 std::chrono::steady_clock::time_point limit) {
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+      limit - std::chrono::steady_clock::now());
+  return std::clamp(left, std::chrono::milliseconds(0), budget);
+}
+
 }  // namespace
 
 void BlockServerSignals() {
@@ -72,6 +118,32 @@ void BlockServerSignals() {
 int RunServer(const ServerConfig& config) {
   BlockServerSignals();  // before any thread starts, so all of them inherit the mask
   LogEvent(spdlog::level::info, "starting", ServerConfigToJson(config));
+
+  // TLS files and tokens are checked before anything listens: a typo must not start a server
+  // that is open (no tokens) or unreachable (no certificate).
+  std::optional<TlsMaterial> tls;
+  if (const TlsFiles files{config.tls_cert, config.tls_key, config.tls_client_ca};
+      files.enabled()) {
+    Result<TlsMaterial> loaded = LoadTlsMaterial(files);
+    if (!loaded.ok()) {
+      LogEvent(spdlog::level::err, "tls refused", {{"error", loaded.status().message()}});
+      std::cerr << "tod_server: " << loaded.status().message() << "\n";
+      return 2;
+    }
+    tls = std::move(*loaded);
+  }
+  std::shared_ptr<TokenAuthenticator> auth;
+  if (!config.auth_token_file.empty()) {
+    Result<std::shared_ptr<TokenAuthenticator>> loaded =
+        TokenAuthenticator::FromFile(config.auth_token_file);
+    if (!loaded.ok()) {
+      LogEvent(spdlog::level::err, "auth tokens refused", {{"error", loaded.status().message()}});
+      std::cerr << "tod_server: " << loaded.status().message() << "\n";
+      return 2;
+    }
+    auth = std::move(*loaded);
+    LogEvent(spdlog::level::info, "auth tokens loaded", {{"tokens", auth->token_count()}});
+  }
 
   ServerMetrics metrics;
   ModelHolder models;
@@ -85,13 +157,15 @@ int RunServer(const ServerConfig& config) {
 
   // Listeners come up first and report not-ready until the model is loaded, so orchestrators
   // can tell "starting" from "dead".
-  ObstacleDiscoveryService service(engine, models, metrics);
+  ObstacleDiscoveryService service(engine, models, metrics, auth);
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int grpc_port = 0;
   const std::string grpc_address = config.host + ":" + std::to_string(config.grpc_port);
-  builder.AddListeningPort(grpc_address, grpc::InsecureServerCredentials(), &grpc_port);
+  builder.AddListeningPort(grpc_address,
+                           tls ? GrpcServerCredentials(*tls) : grpc::InsecureServerCredentials(),
+                           &grpc_port);
   builder.SetMaxReceiveMessageSize(static_cast<int>(config.max_image_bytes + kGrpcMessageSlack));
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> grpc_server = builder.BuildAndStart();
@@ -111,6 +185,16 @@ int RunServer(const ServerConfig& config) {
   http_config.limits = HttpLimitsFrom(config);
   http_config.retry_after_s = config.retry_after_s;
   http_config.io_threads = config.http_threads;
+  http_config.auth = auth;
+  if (tls) {
+    Result<std::shared_ptr<boost::asio::ssl::context>> https = HttpsContext(*tls);
+    if (!https.ok()) {  // LoadTlsMaterial built one already; this cannot fail differently
+      std::cerr << "tod_server: " << https.status().message() << "\n";
+      grpc_server->Shutdown();
+      return 2;
+    }
+    http_config.tls = std::move(*https);
+  }
   HttpFrontend http(http_config, engine, models, metrics);
   if (Status bound = http.Bind(config.host, config.http_port); !bound.ok()) {
     LogEvent(spdlog::level::err, "cannot listen for HTTP", {{"error", bound.message()}});
@@ -121,7 +205,11 @@ int RunServer(const ServerConfig& config) {
   http.Start();
   LogEvent(spdlog::level::info, "listening",
            {{"grpc", config.host + ":" + std::to_string(grpc_port)},
-            {"http", config.host + ":" + std::to_string(http.port())}});
+            {"http", config.host + ":" + std::to_string(http.port())},
+            {"tls", !tls            ? "off"
+                    : tls->mutual() ? "mutual"
+                                    : "on"},
+            {"auth", auth ? "bearer" : "off"}});
 
   if (Status loaded = models.Load(config.model_dir); !loaded.ok()) {
     LogEvent(spdlog::level::err, "model bundle refused", {{"error", loaded.ToString()}});
@@ -149,6 +237,16 @@ int RunServer(const ServerConfig& config) {
         LogEvent(spdlog::level::err, "reload refused; the previous model keeps serving",
                  {{"error", reloaded.ToString()}});
       }
+      if (auth) {
+        const Status tokens = auth->Reload();
+        metrics.RecordTokenReload(tokens.ok());
+        if (tokens.ok()) {
+          LogEvent(spdlog::level::info, "auth tokens reloaded", {{"tokens", auth->token_count()}});
+        } else {
+          LogEvent(spdlog::level::err, "token reload refused; the previous tokens stay",
+                   {{"error", tokens.message()}});
+        }
+      }
       continue;
     }
     LogEvent(spdlog::level::info, "draining",
@@ -158,19 +256,32 @@ int RunServer(const ServerConfig& config) {
     break;
   }
 
-  // Drain: refuse new work and report not-serving, let admitted work finish, then close.
+  // Drain: refuse new work and report not-serving, let admitted work finish until the drain
+  // deadline, then answer what is still queued with UNAVAILABLE / 503 and cancel what runs (it
+  // stops at its next stage boundary). Everything after the deadline has one second in all:
+  // answers being written get what is left of it, and the process exits at the latest then.
+  using std::chrono::milliseconds;
+  using std::chrono::steady_clock;
   engine.BeginDrain();
   health->SetServingStatus(false);
-  const auto drain_deadline =
-      std::chrono::steady_clock::now() +
-      std::chrono::milliseconds(static_cast<long long>(config.drain_timeout_s * 1000));
+  const steady_clock::time_point drain_deadline =
+      steady_clock::now() + Milliseconds(config.drain_timeout_s);
+  const steady_clock::time_point hard_limit = drain_deadline + milliseconds(950);
   const bool drained = engine.WaitIdle(drain_deadline);
+  ExitDeadline exit_deadline(hard_limit);
   if (!drained) {
-    LogEvent(spdlog::level::warn, "drain timeout: unfinished requests are cancelled",
+    LogEvent(spdlog::level::warn,
+             "drain timeout: queued requests are refused, running ones cancelled",
              {{"queued", engine.queue_depth()}});
+    engine.CancelAll(CancelReason::kDrain);
+    if (!engine.WaitIdle(drain_deadline + milliseconds(500))) {
+      LogEvent(spdlog::level::warn, "drain timeout: a pipeline stage is still running");
+    }
   }
-  grpc_server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
-  http.Stop();
+  // Calls still open (an idle DetectStream, say) are cancelled at the gRPC deadline.
+  grpc_server->Shutdown(std::chrono::system_clock::now() +
+                        Within(milliseconds(2000), hard_limit - milliseconds(250)));
+  http.Stop(Within(milliseconds(5000), hard_limit - milliseconds(100)));
   engine.Stop();
   LogEvent(spdlog::level::info, "stopped", {{"drained", drained}});
   spdlog::default_logger()->flush();

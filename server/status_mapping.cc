@@ -20,6 +20,8 @@ grpc::StatusCode ToGrpcCode(StatusCode code) {
       return grpc::StatusCode::UNAVAILABLE;
     case StatusCode::kDeadlineExceeded:
       return grpc::StatusCode::DEADLINE_EXCEEDED;
+    case StatusCode::kCancelled:
+      return grpc::StatusCode::CANCELLED;
     case StatusCode::kInternal:
       return grpc::StatusCode::INTERNAL;
   }
@@ -88,6 +90,8 @@ int HttpStatusFor(const Status& status, Rejection rejection) {
       return 503;
     case StatusCode::kDeadlineExceeded:
       return 504;
+    case StatusCode::kCancelled:
+      return 499;  // nginx's "client closed request": the client is gone, nobody reads it
     case StatusCode::kFailedPrecondition:
     case StatusCode::kDataLoss:
     case StatusCode::kInternal:

@@ -30,6 +30,9 @@ std::string Status::ToString() const {
     case StatusCode::kDeadlineExceeded:
       name = "DEADLINE_EXCEEDED";
       break;
+    case StatusCode::kCancelled:
+      name = "CANCELLED";
+      break;
     case StatusCode::kInternal:
       name = "INTERNAL";
       break;

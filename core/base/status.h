@@ -18,6 +18,7 @@ enum class StatusCode {
   kResourceExhausted,   // over a size limit
   kUnavailable,
   kDeadlineExceeded,
+  kCancelled,  // the caller gave up (client went away, server draining): the work was stopped
   kInternal,
 };
 
@@ -41,6 +42,9 @@ class [[nodiscard]] Status {
   }
   static Status DeadlineExceeded(std::string msg) {
     return Status(StatusCode::kDeadlineExceeded, std::move(msg));
+  }
+  static Status Cancelled(std::string msg) {
+    return Status(StatusCode::kCancelled, std::move(msg));
   }
   static Status Internal(std::string msg) { return Status(StatusCode::kInternal, std::move(msg)); }
 

@@ -2,6 +2,7 @@
 // const and thread-safe. This is the only header the server and the CLI need.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -21,6 +22,11 @@ struct DetectOptions {
   // an empty road reports no obstacle.
   float min_obstacle_score = 0.5f;
   bool want_probability_map = true;
+  // Asked between stages (after edges, superpixels, occlusion, proposals, features, regression);
+  // when it returns a non-OK Status (Cancelled, DeadlineExceeded, ...) Detect stops and returns
+  // it. A stage itself is never interrupted, so the hook only has to be cheap and thread-safe.
+  // Empty: run to the end.
+  std::function<Status()> cancelled;
 };
 
 struct Proposal {

@@ -15,8 +15,10 @@ OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerReg
                                      const EdgeSource& edges, const OcclusionClassifier* classifier,
                                      const PipelineParams& params, bool enhance,
                                      StageTimer* timer) {
+  // Marks a stage boundary; true when the timer's check asks to stop here.
   auto mark = [timer](const char* stage) {
     if (timer != nullptr) timer->Mark(stage);
+    return timer != nullptr && !timer->stopped().ok();
   };
   OcclusionEdges out;
   out.r1 = ClipToImage(regions.layers.front(), image.cols, image.rows);
@@ -34,13 +36,13 @@ OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerReg
       out.enhanced(local) += out.base_edge(local);
     }
   }
-  mark("edges");
+  if (mark("edges")) return out;
   out.superpixels = ComputeStickySuperpixels(out.crop, out.enhanced, params.superpixels);
-  mark("superpixels");
+  if (mark("superpixels")) return out;
   if (classifier != nullptr) {
     out.occlusion = classifier->Paint(out.crop, out.enhanced, out.superpixels);
     CorrectSampledPrior(out.occlusion, params.prior_correction.occlusion_odds);
-    mark("occlusion");
+    (void)mark("occlusion");  // the caller checks timer->stopped() after the last stage
   }
   return out;
 }

@@ -12,6 +12,7 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   RegressedProposals out;
   const cv::Mat1f features = ComputeProposalFeatures(image, oaocc, regions, proposals);
   if (timer) timer->Mark("features");
+  if (timer && !timer->stopped().ok()) return out;  // cancelled: the caller returns the Status
   out.ordr = bundle.ordr.PredictBatch(features);
   // OBDR only matters for the boxes that pass the fusion gate (top keep_ratio by ORDR, §6.5), so
   // only those are scored; the rest keep OBDR 0.
@@ -77,18 +78,21 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   if (bgr.cols < 16 || bgr.rows < 16)
     return Status::InvalidArgument("image too small: " + std::to_string(bgr.cols) + "x" +
                                    std::to_string(bgr.rows) + " (at least 16x16)");
-  StageTimer timer;
+  StageTimer timer(options.cancelled);  // asks options.cancelled at every stage boundary
   const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
   const OcclusionEdges oaocc = ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges,
                                                      &bundle_.occlusion, bundle_.params,
                                                      /*enhance=*/true, &timer);
+  if (!timer.stopped().ok()) return timer.stopped();
   const ProposalOptions proposal_options =
       DetectorProposalOptions(bundle_.params, geometry.regions.num_layers());
   ProposalSet proposals = ProposeBoxes(oaocc, geometry.regions, bundle_.params.boxes,
                                        proposal_options, geometry.size_filter);
   timer.Mark("proposals");
+  if (!timer.stopped().ok()) return timer.stopped();
   RegressedProposals regressed =
       RegressProposals(bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer);
+  if (!timer.stopped().ok()) return timer.stopped();
   const std::vector<float> fused =
       FuseScores(regressed.ordr, regressed.obdr, bundle_.params.fusion);
 

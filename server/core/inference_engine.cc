@@ -22,6 +22,26 @@ InferenceResult Refusal(Status status, Rejection rejection) {
   return result;
 }
 
+// A request whose work was stopped (or never started) because of `reason`.
+InferenceResult Stopped(CancelReason reason, const std::string& where) {
+  InferenceResult result =
+      Refusal(CancelledStatus(reason, where),
+              reason == CancelReason::kDeadline ? Rejection::kDeadline : Rejection::kCancelled);
+  result.cancelled = reason;
+  return result;
+}
+
+// Why the job must stop now, if it must: its caller gave up, the drain timeout came, or its
+// deadline passed (which is then recorded in the Cancellation, so the first reason sticks).
+std::optional<CancelReason> StopReason(
+    Cancellation& cancellation,
+    const std::optional<std::chrono::steady_clock::time_point>& deadline) {
+  if (!cancellation.cancelled() && deadline && std::chrono::steady_clock::now() >= *deadline) {
+    cancellation.Cancel(CancelReason::kDeadline);
+  }
+  return cancellation.reason();
+}
+
 }  // namespace
 
 const char* RejectionName(Rejection rejection) {
@@ -40,6 +60,8 @@ const char* RejectionName(Rejection rejection) {
       return "bad_request";
     case Rejection::kDeadline:
       return "deadline";
+    case Rejection::kCancelled:
+      return "cancelled";
     case Rejection::kInternal:
       return "internal";
   }
@@ -80,6 +102,9 @@ void InferenceEngine::Finish(Completion& done, InferenceResult result,
   result.total_ms = MillisecondsSince(submitted);
   if (metrics_ != nullptr && result.rejection != Rejection::kNone) {
     metrics_->RecordRejection(RejectionName(result.rejection));
+  }
+  if (metrics_ != nullptr && result.cancelled) {
+    metrics_->RecordCancelled(CancelReasonName(*result.cancelled));
   }
   done(std::move(result));
 }
@@ -135,7 +160,9 @@ void InferenceEngine::Submit(const InferenceRequest& request, Completion done) {
              submitted);
       return;
     }
-    queue_.push_back(Job{request, std::move(done), submitted});
+    std::shared_ptr<Cancellation> cancellation =
+        request.cancellation ? request.cancellation : std::make_shared<Cancellation>();
+    queue_.push_back(Job{request, std::move(done), submitted, std::move(cancellation)});
     if (metrics_ != nullptr) {
       metrics_->SetQueueDepth(static_cast<double>(queue_.size()));
       metrics_->AddInFlight(1);
@@ -158,6 +185,7 @@ void InferenceEngine::WorkerLoop() {
       job = std::move(queue_.front());
       queue_.pop_front();
       ++running_;
+      running_cancellations_.push_back(job.cancellation);
       stop_now = stopping_;
       if (metrics_ != nullptr) metrics_->SetQueueDepth(static_cast<double>(queue_.size()));
     }
@@ -173,6 +201,7 @@ void InferenceEngine::WorkerLoop() {
     {
       std::lock_guard lock(mutex_);
       --running_;
+      std::erase(running_cancellations_, job.cancellation);
     }
     idle_.notify_all();
   }
@@ -182,11 +211,10 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
   const double queue_ms = MillisecondsSince(job.submitted);
   if (metrics_ != nullptr) metrics_->ObserveQueueWait(queue_ms / 1000.0);
   const InferenceRequest& request = job.request;
-  if (request.deadline && Clock::now() >= *request.deadline) {
-    return Refusal(Status::DeadlineExceeded("deadline passed after " +
-                                            std::to_string(static_cast<int>(queue_ms)) +
-                                            " ms in the queue; the request was not run"),
-                   Rejection::kDeadline);
+  Cancellation& cancellation = *job.cancellation;
+  if (const std::optional<CancelReason> reason = StopReason(cancellation, request.deadline)) {
+    return Stopped(*reason, "after " + std::to_string(static_cast<int>(queue_ms)) +
+                                " ms in the queue, before the request ran");
   }
   InferenceResult result;
   result.timings.emplace_back("queue", queue_ms);
@@ -205,11 +233,26 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
   }
   timer.Mark("decode");
   result.timings.insert(result.timings.end(), timer.times().begin(), timer.times().end());
+  if (const std::optional<CancelReason> reason = StopReason(cancellation, request.deadline)) {
+    return Stopped(*reason, "after decoding");
+  }
 
   DetectOptions options = request.options;
   options.want_probability_map = request.encode_map_png;
+  // Asked between the pipeline's stages; the Status it returns is only a signal here: the result
+  // is rebuilt from the reason below so the message says where the work stopped.
+  int boundaries = 0;  // stage boundaries passed, for the message
+  options.cancelled = [&cancellation, &request, &boundaries] {
+    ++boundaries;
+    return StopReason(cancellation, request.deadline) ? Status::Cancelled("stop") : Status::Ok();
+  };
   try {
     Result<Detection> detection = result.model->detector->Detect(*image, options);
+    if (const std::optional<CancelReason> reason = cancellation.reason();
+        !detection.ok() && reason) {
+      return Stopped(*reason, "while the pipeline ran (at its stage boundary " +
+                                  std::to_string(boundaries) + ")");
+    }
     if (!detection.ok()) {
       const Rejection why = detection.status().code() == StatusCode::kInvalidArgument
                                 ? Rejection::kBadImage
@@ -223,6 +266,10 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
   }
   result.timings.insert(result.timings.end(), result.detection.timings.begin(),
                         result.detection.timings.end());
+  // The last boundary: a caller that gave up during the final stage gets no OK either.
+  if (const std::optional<CancelReason> reason = StopReason(cancellation, request.deadline)) {
+    return Stopped(*reason, "after the pipeline ran");
+  }
 
   if (request.encode_map_png && !result.detection.probability.empty()) {
     const Clock::time_point encode_start = Clock::now();
@@ -258,6 +305,26 @@ size_t InferenceEngine::queue_depth() const {
 bool InferenceEngine::WaitIdle(Clock::time_point deadline) {
   std::unique_lock lock(mutex_);
   return idle_.wait_until(lock, deadline, [this] { return queue_.empty() && running_ == 0; });
+}
+
+void InferenceEngine::CancelAll(CancelReason reason) {
+  std::deque<Job> queued;
+  {
+    std::lock_guard lock(mutex_);
+    draining_ = true;
+    queued.swap(queue_);
+    for (const std::shared_ptr<Cancellation>& running : running_cancellations_) {
+      running->Cancel(reason);
+    }
+    if (metrics_ != nullptr) metrics_->SetQueueDepth(0);
+  }
+  for (Job& job : queued) {
+    job.cancellation->Cancel(reason);
+    Finish(job.done, Stopped(*job.cancellation->reason(), "while the request was queued"),
+           job.submitted);
+    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
+  }
+  idle_.notify_all();
 }
 
 void InferenceEngine::Stop() {

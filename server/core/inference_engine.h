@@ -3,8 +3,9 @@
 //
 // A request is checked (readiness, byte size, image header and pixel count) when submitted and
 // refused at once if it cannot be served; otherwise it waits in one bounded FIFO queue for one of
-// N workers. A worker skips a request whose deadline passed while it was queued, decodes the image,
-// takes a snapshot of the current model and runs the pipeline.
+// N workers. A worker skips a request whose deadline passed or whose caller gave up while it was
+// queued, decodes the image, takes a snapshot of the current model and runs the pipeline, asking
+// the request's Cancellation (and its deadline) at every stage boundary.
 #pragma once
 
 #include <chrono>
@@ -23,6 +24,7 @@
 #include "core/base/stage_timer.h"
 #include "core/base/status.h"
 #include "core/pipeline/detector.h"
+#include "server/core/cancellation.h"
 #include "server/core/image_codec.h"
 #include "server/core/model_holder.h"
 
@@ -38,7 +40,8 @@ enum class Rejection {
   kTooLarge,    // byte or pixel limit                -> RESOURCE_EXHAUSTED / 413
   kBadImage,    // empty / undecodable                -> INVALID_ARGUMENT / 400
   kBadRequest,  // invalid option                     -> INVALID_ARGUMENT / 400
-  kDeadline,    // deadline passed while queued       -> DEADLINE_EXCEEDED / 504
+  kDeadline,    // deadline passed (queued or running) -> DEADLINE_EXCEEDED / 504
+  kCancelled,   // client gone, or the drain timeout   -> CANCELLED / 499, UNAVAILABLE / 503
   kInternal,    // pipeline failure                   -> INTERNAL / 500
 };
 // Stable lower-case name, used as the metrics label "reason".
@@ -49,6 +52,8 @@ struct InferenceRequest {
   DetectOptions options;
   bool encode_map_png = true;
   std::optional<std::chrono::steady_clock::time_point> deadline;
+  // Set by the front end when its caller gives up; null: the engine makes one (deadline, drain).
+  std::shared_ptr<Cancellation> cancellation;
 };
 
 struct InferenceResult {
@@ -56,6 +61,7 @@ struct InferenceResult {
   Rejection rejection = Rejection::kNone;
   Detection detection;                       // valid when status.ok()
   std::string map_png;                       // when requested and status.ok()
+  std::optional<CancelReason> cancelled;     // why the work was stopped, when it was
   std::shared_ptr<const LoadedModel> model;  // the model that served the request
   StageTimes timings;                        // "queue", "decode", pipeline stages, "encode_map"
   double total_ms = 0;                       // submission to completion
@@ -90,6 +96,10 @@ class InferenceEngine {
   bool draining() const;
   // Waits until nothing is queued or running; false when `deadline` came first.
   bool WaitIdle(std::chrono::steady_clock::time_point deadline);
+  // The drain timeout: queued requests complete at once with UNAVAILABLE, running ones are
+  // cancelled (they stop at their next stage boundary, also with UNAVAILABLE); new ones are
+  // refused. Returns at once; WaitIdle() then tells when the running ones have stopped.
+  void CancelAll(CancelReason reason);
   // Requests still queued complete with UNAVAILABLE; running ones finish; workers are joined.
   void Stop();
 
@@ -102,6 +112,7 @@ class InferenceEngine {
     InferenceRequest request;
     Completion done;
     Clock::time_point submitted;
+    std::shared_ptr<Cancellation> cancellation;  // never null
   };
 
   void WorkerLoop();
@@ -118,6 +129,7 @@ class InferenceEngine {
   std::condition_variable idle_;
   std::deque<Job> queue_;
   int running_ = 0;
+  std::vector<std::shared_ptr<Cancellation>> running_cancellations_;  // of the running jobs
   bool draining_ = false;
   bool stopping_ = false;
   std::vector<std::thread> workers_;

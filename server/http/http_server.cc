@@ -34,11 +34,13 @@ std::string ClientAddress(const tcp::socket& socket) {
 }  // namespace
 
 struct HttpServer::Impl {
-  Impl(HttpLimits limits, int threads, int retry_after_s, Router router, HttpObserver observer)
-      : context(limits, std::move(router), std::move(observer), retry_after_s),
-        limiter(limits.max_connections, limits.max_connections_per_client,
+  Impl(HttpServerOptions options, Router router, HttpObserver observer)
+      : context(options.limits, std::move(router), std::move(observer), options.retry_after_s,
+                std::move(options.authorizer)),
+        limiter(options.limits.max_connections, options.limits.max_connections_per_client,
                 context.observer.on_open_connections),
-        io_threads(threads) {}
+        tls(std::move(options.tls)),
+        io_threads(options.io_threads) {}
 
   void Accept() {
     acceptor.async_accept(net::make_strand(io),
@@ -59,26 +61,39 @@ struct HttpServer::Impl {
   }
 
   void Admit(tcp::socket socket) {
-    std::string client = ClientAddress(socket);
+    const std::string client = ClientAddress(socket);
     ConnectionLimiter::Admission admission = limiter.TryAcquire(client);
-    auto session = std::make_shared<HttpSession>(std::move(socket), client,
-                                                 std::move(admission.ticket), context);
-    if (!admission.refused) {
+    if (tls) {
+      Serve(std::make_shared<HttpSession<TlsStream>>(TlsStream(std::move(socket), *tls), client,
+                                                     std::move(admission.ticket), context),
+            client, admission.refused);
+    } else {
+      Serve(std::make_shared<HttpSession<PlainStream>>(std::move(socket), client,
+                                                       std::move(admission.ticket), context),
+            client, admission.refused);
+    }
+  }
+
+  template <class Session>
+  void Serve(const std::shared_ptr<Session>& session, const std::string& client,
+             std::optional<RefusalReason> refused) {
+    if (!refused) {
       session->Start();
       return;
     }
     const HttpLimits& limits = context.limits;
     const std::string message =
-        *admission.refused == RefusalReason::kTooManyConnections
+        *refused == RefusalReason::kTooManyConnections
             ? "server busy: " + std::to_string(limits.max_connections) + " connections are open"
             : "too many connections from " + client + " (limit " +
                   std::to_string(limits.max_connections_per_client) + ")";
-    session->StartRefused(*admission.refused, message);
+    session->StartRefused(*refused, message);
   }
 
   // Declared first so that it outlives `io`, whose destruction destroys the connections.
   SessionContext context;
   ConnectionLimiter limiter;
+  const std::shared_ptr<net::ssl::context> tls;  // null: plain HTTP
   net::io_context io;
   std::optional<net::executor_work_guard<net::io_context::executor_type>> work;
   tcp::acceptor acceptor{net::make_strand(io)};
@@ -88,10 +103,8 @@ struct HttpServer::Impl {
   int port = 0;
 };
 
-HttpServer::HttpServer(HttpLimits limits, int io_threads, int retry_after_s, Router router,
-                       HttpObserver observer)
-    : impl_(std::make_unique<Impl>(limits, io_threads, retry_after_s, std::move(router),
-                                   std::move(observer))) {}
+HttpServer::HttpServer(HttpServerOptions options, Router router, HttpObserver observer)
+    : impl_(std::make_unique<Impl>(std::move(options), std::move(router), std::move(observer))) {}
 
 HttpServer::~HttpServer() { Stop(); }
 

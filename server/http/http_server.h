@@ -4,6 +4,7 @@
 // Handlers must not block: they answer through their Responder, from any thread.
 #pragma once
 
+#include <boost/asio/ssl/context.hpp>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -15,10 +16,19 @@
 
 namespace tod::server::http {
 
+// HTTPS when `tls` is set (the context holds the certificate, key and, for mutual TLS, the client
+// CA and verify mode); `authorizer` (optional) is asked for every routed request's header.
+struct HttpServerOptions {
+  HttpLimits limits;
+  int io_threads = 2;
+  int retry_after_s = 1;
+  std::shared_ptr<boost::asio::ssl::context> tls;
+  Authorizer authorizer;
+};
+
 class HttpServer {
  public:
-  HttpServer(HttpLimits limits, int io_threads, int retry_after_s, Router router,
-             HttpObserver observer);
+  HttpServer(HttpServerOptions options, Router router, HttpObserver observer);
   // Stops (see Stop). Requests still held by handlers must have been answered or dropped.
   ~HttpServer();
   HttpServer(const HttpServer&) = delete;

@@ -1,5 +1,6 @@
 #include "server/http/http_session.h"
 
+#include <algorithm>
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/beast/core/string.hpp>
@@ -7,6 +8,7 @@
 #include <boost/beast/http/read.hpp>
 #include <boost/beast/http/write.hpp>
 #include <exception>
+#include <utility>
 
 namespace tod::server::http {
 namespace {
@@ -36,10 +38,11 @@ std::string Milliseconds(std::chrono::milliseconds ms) { return std::to_string(m
 
 }  // namespace
 
-HttpSession::HttpSession(Socket socket, std::string peer, ConnectionLimiter::Ticket ticket,
-                         SessionContext& context)
-    : socket_(std::move(socket)),
-      deadline_(socket_.get_executor()),
+template <class Stream>
+HttpSession<Stream>::HttpSession(Stream stream, std::string peer, ConnectionLimiter::Ticket ticket,
+                                 SessionContext& context)
+    : stream_(std::move(stream)),
+      deadline_(stream_.get_executor()),
       peer_(std::move(peer)),
       ticket_(std::move(ticket)),
       context_(context),
@@ -48,32 +51,68 @@ HttpSession::HttpSession(Socket socket, std::string peer, ConnectionLimiter::Tic
   continue_.result(beast_http::status::continue_);
 }
 
-void HttpSession::Start() {
-  net::dispatch(socket_.get_executor(), [self = shared_from_this()] { self->WaitForRequest(); });
+template <class Stream>
+void HttpSession<Stream>::Start() {
+  net::dispatch(stream_.get_executor(), [self = this->shared_from_this()] {
+    self->Handshake([self] { self->WaitForRequest(); });
+  });
 }
 
-void HttpSession::StartRefused(RefusalReason reason, std::string message) {
-  net::dispatch(socket_.get_executor(),
-                [self = shared_from_this(), reason, message = std::move(message)]() mutable {
-                  self->RefuseAndClose(reason, std::move(message));
+template <class Stream>
+void HttpSession<Stream>::StartRefused(RefusalReason reason, std::string message) {
+  net::dispatch(stream_.get_executor(),
+                [self = this->shared_from_this(), reason, message = std::move(message)]() mutable {
+                  // Over TLS the refusal can only be answered after the handshake.
+                  self->Handshake([self, reason, message = std::move(message)]() mutable {
+                    self->RefuseAndClose(reason, std::move(message));
+                  });
                 });
 }
 
-void HttpSession::ArmDeadline(Clock::time_point when) {
+template <class Stream>
+void HttpSession<Stream>::Handshake(std::function<void()> next) {
+  if constexpr (!kTls) {
+    next();
+  } else {
+    ArmDeadline(context_.limits.request_timeout);
+    stream_.async_handshake(
+        net::ssl::stream_base::server,
+        [self = this->shared_from_this(), next = std::move(next)](beast::error_code ec) {
+          if (self->TakeExpired()) {
+            self->Report(RefusalReason::kTlsHandshake,
+                         "TLS handshake did not finish within " +
+                             Milliseconds(self->context_.limits.request_timeout) + " ms");
+            self->Close();
+          } else if (ec) {
+            self->Report(RefusalReason::kTlsHandshake, "TLS handshake failed: " + ec.message());
+            self->Close();
+          } else {
+            next();
+          }
+        });
+  }
+}
+
+template <class Stream>
+void HttpSession<Stream>::ArmDeadline(Clock::time_point when) {
   expired_ = false;
   deadline_.expires_at(when);
-  deadline_.async_wait([self = shared_from_this()](beast::error_code ec) {
+  deadline_.async_wait([self = this->shared_from_this()](beast::error_code ec) {
     // A wait that completes after the deadline moved (or was cancelled) is stale.
     if (ec || self->deadline_.expiry() > Clock::now()) return;
     self->expired_ = true;
     beast::error_code ignored;
-    self->socket_.cancel(ignored);
+    self->socket().cancel(ignored);
   });
 }
 
-bool HttpSession::TakeExpired() { return std::exchange(expired_, false); }
+template <class Stream>
+bool HttpSession<Stream>::TakeExpired() {
+  return std::exchange(expired_, false);
+}
 
-void HttpSession::WaitForRequest() {
+template <class Stream>
+void HttpSession<Stream>::WaitForRequest() {
   if (context_.stopping) {
     LingeringClose();
     return;
@@ -84,28 +123,29 @@ void HttpSession::WaitForRequest() {
   }
   // Idle: nothing of a request yet. The request deadline starts with its first byte.
   ArmDeadline(context_.limits.idle_timeout);
-  socket_.async_read_some(
-      buffer_.prepare(kReadChunk), [self = shared_from_this()](beast::error_code ec, size_t bytes) {
-        if (self->TakeExpired()) {
-          // A kept-alive connection going quiet is normal; a new one that never speaks is not.
-          if (self->requests_ == 0) {
-            self->Report(RefusalReason::kIdleTimeout,
-                         "no request within " + Milliseconds(self->context_.limits.idle_timeout) +
-                             " ms of connecting");
-          }
-          self->Close();
-          return;
-        }
-        if (ec) {
-          self->Close();
-          return;
-        }
-        self->buffer_.commit(bytes);
-        self->BeginRequest();
-      });
+  stream_.async_read_some(buffer_.prepare(kReadChunk), [self = this->shared_from_this()](
+                                                           beast::error_code ec, size_t bytes) {
+    if (self->TakeExpired()) {
+      // A kept-alive connection going quiet is normal; a new one that never speaks is not.
+      if (self->requests_ == 0) {
+        self->Report(RefusalReason::kIdleTimeout,
+                     "no request within " + Milliseconds(self->context_.limits.idle_timeout) +
+                         " ms of connecting");
+      }
+      self->Close();
+      return;
+    }
+    if (ec) {
+      self->Close();
+      return;
+    }
+    self->buffer_.commit(bytes);
+    self->BeginRequest();
+  });
 }
 
-void HttpSession::BeginRequest() {
+template <class Stream>
+void HttpSession<Stream>::BeginRequest() {
   const HttpLimits& limits = context_.limits;
   ArmDeadline(limits.request_timeout);  // one deadline for the whole request, header and body
   target_.clear();
@@ -113,11 +153,12 @@ void HttpSession::BeginRequest() {
   parser_->header_limit(limits.max_header_bytes);
   parser_->body_limit(limits.max_body_bytes);
   beast_http::async_read_header(
-      socket_, buffer_, *parser_,
-      [self = shared_from_this()](beast::error_code ec, size_t) { self->OnHeader(ec); });
+      stream_, buffer_, *parser_,
+      [self = this->shared_from_this()](beast::error_code ec, size_t) { self->OnHeader(ec); });
 }
 
-void HttpSession::OnHeader(beast::error_code ec) {
+template <class Stream>
+void HttpSession<Stream>::OnHeader(beast::error_code ec) {
   if (ec) {
     OnReadError(ec);
     return;
@@ -127,6 +168,13 @@ void HttpSession::OnHeader(beast::error_code ec) {
   // Routed now so that a wrong method or path is answered as such (405 / 404, after the body is
   // read within the limits) rather than as a missing length.
   match_ = context_.router.Find(request.method(), request.target());
+  // Authentication before the body: a client without a valid token costs no body bytes.
+  if (!match_.refused && context_.authorizer) {
+    if (std::optional<std::string> refused = context_.authorizer(request)) {
+      RefuseAndClose(RefusalReason::kUnauthenticated, std::move(*refused));
+      return;
+    }
+  }
   const boost::optional<uint64_t> length = parser_->content_length();
   if (!match_.refused && IsPostOrPut(request.method()) && !length && !parser_->chunked()) {
     RefuseAndClose(RefusalReason::kLengthRequired, std::string(request.method_string()) +
@@ -153,8 +201,8 @@ void HttpSession::OnHeader(beast::error_code ec) {
   if (beast::iequals(request[beast_http::field::expect], "100-continue")) {
     // curl and others wait for this before sending a large body.
     continue_.version(request.version());
-    beast_http::async_write(socket_, continue_,
-                            [self = shared_from_this()](beast::error_code write_ec, size_t) {
+    beast_http::async_write(stream_, continue_,
+                            [self = this->shared_from_this()](beast::error_code write_ec, size_t) {
                               if (self->TakeExpired()) {
                                 self->OnReadError(beast::error::timeout);
                               } else if (write_ec) {
@@ -168,13 +216,15 @@ void HttpSession::OnHeader(beast::error_code ec) {
   ReadBody();
 }
 
-void HttpSession::ReadBody() {
+template <class Stream>
+void HttpSession<Stream>::ReadBody() {
   beast_http::async_read(
-      socket_, buffer_, *parser_,
-      [self = shared_from_this()](beast::error_code ec, size_t) { self->OnBody(ec); });
+      stream_, buffer_, *parser_,
+      [self = this->shared_from_this()](beast::error_code ec, size_t) { self->OnBody(ec); });
 }
 
-void HttpSession::OnBody(beast::error_code ec) {
+template <class Stream>
+void HttpSession<Stream>::OnBody(beast::error_code ec) {
   if (ec) {
     OnReadError(ec);
     return;
@@ -182,7 +232,8 @@ void HttpSession::OnBody(beast::error_code ec) {
   Dispatch();
 }
 
-void HttpSession::OnReadError(beast::error_code ec) {
+template <class Stream>
+void HttpSession<Stream>::OnReadError(beast::error_code ec) {
   const HttpLimits& limits = context_.limits;
   if (TakeExpired() || ec == beast::error::timeout) {
     RefuseAndClose(RefusalReason::kReadTimeout, "the request did not arrive completely within " +
@@ -203,7 +254,8 @@ void HttpSession::OnReadError(beast::error_code ec) {
   }
 }
 
-void HttpSession::Dispatch() {
+template <class Stream>
+void HttpSession<Stream>::Dispatch() {
   deadline_.cancel();  // the handler's own deadlines (queue, engine) apply from here
   Request request = parser_->release();
   parser_.reset();
@@ -229,20 +281,57 @@ void HttpSession::Dispatch() {
   awaiting_handler_ = true;
   in_flight_ = true;
   ++context_.in_flight;
-  Responder respond = [self = shared_from_this()](Response response) {
-    net::post(self->socket_.get_executor(), [self, response = std::move(response)]() mutable {
+  client_gone_ = std::make_shared<Cancellation>();
+  Responder respond = [self = this->shared_from_this()](Response response) {
+    net::post(self->stream_.get_executor(), [self, response = std::move(response)]() mutable {
       self->OnHandlerResponse(std::move(response));
     });
   };
   try {
-    (*match.handler)(IncomingRequest{std::move(request), peer_}, std::move(respond));
+    (*match.handler)(IncomingRequest{std::move(request), peer_, client_gone_}, std::move(respond));
   } catch (const std::exception& e) {
     Report(RefusalReason::kInternal, std::string("handler failed: ") + e.what());
     OnHandlerResponse(JsonErrorResponse(500, "INTERNAL", "the request could not be handled"));
   }
+  // Answers arrive through a post to this strand, never inline: the handler is still at work.
+  if (awaiting_handler_) Watch();
 }
 
-void HttpSession::OnHandlerResponse(Response response) {
+template <class Stream>
+void HttpSession<Stream>::Watch() {
+  const size_t room = buffer_.max_size() - buffer_.size();
+  if (room == 0) return;  // a pipelining client filled the buffer: it is there, no need to watch
+  watching_ = true;
+  stream_.async_read_some(buffer_.prepare(std::min(room, kReadChunk)),
+                          [self = this->shared_from_this()](beast::error_code ec, size_t bytes) {
+                            self->OnWatch(ec, bytes);
+                          });
+}
+
+template <class Stream>
+void HttpSession<Stream>::OnWatch(beast::error_code ec, size_t bytes) {
+  watching_ = false;
+  if (closed_) return;
+  if (!ec) buffer_.commit(bytes);
+  if (awaiting_handler_) {
+    if (ec) {  // EOF or reset while the request is handled: nobody will read the answer
+      client_gone_->Cancel(CancelReason::kClientDisconnected);
+      Close();
+    }
+    // Bytes of a next (pipelined) request: the client is there; they wait in buffer_.
+    return;
+  }
+  if (writing_) return;  // OnWritten goes on (and sees a broken connection itself)
+  // The answer is written and this read has been the wait for the next request.
+  if (TakeExpired() || ec) {
+    Close();
+    return;
+  }
+  BeginRequest();
+}
+
+template <class Stream>
+void HttpSession<Stream>::OnHandlerResponse(Response response) {
   if (!awaiting_handler_) return;  // answered already (a handler threw after answering)
   awaiting_handler_ = false;       // still in flight until written (see OnWritten)
   const bool keep_alive = keep_alive_ && !context_.stopping && response.keep_alive();
@@ -251,13 +340,15 @@ void HttpSession::OnHandlerResponse(Response response) {
   Write(std::move(response), keep_alive ? After::kKeepAlive : After::kClose);
 }
 
-void HttpSession::Report(RefusalReason reason, std::string message) const {
+template <class Stream>
+void HttpSession<Stream>::Report(RefusalReason reason, std::string message) const {
   if (context_.observer.on_refusal) {
     context_.observer.on_refusal(Refusal{reason, std::move(message), peer_, target_});
   }
 }
 
-void HttpSession::RefuseAndClose(RefusalReason reason, std::string message) {
+template <class Stream>
+void HttpSession<Stream>::RefuseAndClose(RefusalReason reason, std::string message) {
   const unsigned status = RefusalHttpStatus(reason);
   Report(reason, message);
   if (status == 0) {
@@ -268,22 +359,29 @@ void HttpSession::RefuseAndClose(RefusalReason reason, std::string message) {
   if (status == 503) {
     response.set(beast_http::field::retry_after, std::to_string(context_.retry_after_s));
   }
+  if (reason == RefusalReason::kUnauthenticated) {
+    response.set(beast_http::field::www_authenticate, "Bearer");
+  }
   response.version(11);
   response.keep_alive(false);  // the rest of the request is unread: no way to find the next one
   Write(std::move(response), After::kClose);
 }
 
-void HttpSession::Write(Response response, After after) {
+template <class Stream>
+void HttpSession<Stream>::Write(Response response, After after) {
+  writing_ = true;
   response_.emplace(std::move(response));
   response_->prepare_payload();
   ArmDeadline(context_.limits.write_timeout);
-  beast_http::async_write(socket_, *response_,
-                          [self = shared_from_this(), after](beast::error_code ec, size_t) {
+  beast_http::async_write(stream_, *response_,
+                          [self = this->shared_from_this(), after](beast::error_code ec, size_t) {
                             self->OnWritten(ec, after);
                           });
 }
 
-void HttpSession::OnWritten(beast::error_code ec, After after) {
+template <class Stream>
+void HttpSession<Stream>::OnWritten(beast::error_code ec, After after) {
+  writing_ = false;
   response_.reset();
   LeaveInFlight();
   body_lease_ = ByteBudget::Lease();  // the request body is gone
@@ -298,6 +396,16 @@ void HttpSession::OnWritten(beast::error_code ec, After after) {
     return;
   }
   ++requests_;
+  if (watching_) {
+    // The watch read is still open: it becomes the idle wait for the next request (a second
+    // read cannot be started beside it). Its bytes, if any, start that request in OnWatch.
+    if (after == After::kKeepAlive && !context_.stopping) {
+      ArmDeadline(context_.limits.idle_timeout);
+    } else {
+      Close();  // the request was read whole: nothing to linger for
+    }
+    return;
+  }
   if (after == After::kKeepAlive) {
     WaitForRequest();
   } else {
@@ -305,9 +413,10 @@ void HttpSession::OnWritten(beast::error_code ec, After after) {
   }
 }
 
-void HttpSession::LingeringClose() {
+template <class Stream>
+void HttpSession<Stream>::LingeringClose() {
   beast::error_code ec;
-  socket_.shutdown(Socket::shutdown_send, ec);
+  socket().shutdown(Socket::shutdown_send, ec);
   if (ec) {
     Close();
     return;
@@ -317,29 +426,36 @@ void HttpSession::LingeringClose() {
   Drain();
 }
 
-void HttpSession::Drain() {
-  socket_.async_read_some(net::buffer(drain_),
-                          [self = shared_from_this()](beast::error_code ec, size_t bytes) {
-                            self->drained_ += bytes;
-                            if (ec || self->TakeExpired() || self->drained_ > kLingerBytes) {
-                              self->Close();
-                              return;
-                            }
-                            self->Drain();
-                          });
+template <class Stream>
+void HttpSession<Stream>::Drain() {
+  socket().async_read_some(net::buffer(drain_),
+                           [self = this->shared_from_this()](beast::error_code ec, size_t bytes) {
+                             self->drained_ += bytes;
+                             if (ec || self->TakeExpired() || self->drained_ > kLingerBytes) {
+                               self->Close();
+                               return;
+                             }
+                             self->Drain();
+                           });
 }
 
-void HttpSession::Close() {
+template <class Stream>
+void HttpSession<Stream>::Close() {
+  closed_ = true;
   beast::error_code ignored;
   deadline_.cancel();
-  socket_.shutdown(Socket::shutdown_both, ignored);
-  socket_.close(ignored);
+  socket().shutdown(Socket::shutdown_both, ignored);
+  socket().close(ignored);
   awaiting_handler_ = false;  // a late answer finds the socket closed and is dropped
   LeaveInFlight();
 }
 
-void HttpSession::LeaveInFlight() {
+template <class Stream>
+void HttpSession<Stream>::LeaveInFlight() {
   if (std::exchange(in_flight_, false)) --context_.in_flight;
 }
+
+template class HttpSession<PlainStream>;
+template class HttpSession<TlsStream>;
 
 }  // namespace tod::server::http

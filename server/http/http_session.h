@@ -6,14 +6,24 @@
 //
 // Deadlines come from one timer per connection instead of Beast's tcp_stream timeouts, because
 // tcp_stream closes the socket when its timer fires, which would make the 408 impossible.
-// (TLS later: the session only reads, writes, shuts down and closes `socket_`; making the socket
-// type a template parameter, e.g. asio::ssl::stream<tcp::socket>, adds the handshake step.)
+//
+// The session is a template over its stream: a plain TCP socket, or TLS over it
+// (asio::ssl::stream), which only adds the handshake before the first request. HTTP reads and
+// writes go through the stream; cancelling, half-closing, lingering and closing act on the TCP
+// socket underneath.
+//
+// While a handler works on a request, the session keeps one read open on the connection: when it
+// ends in EOF or an error, the client has gone, and the request's `client_gone` Cancellation is
+// cancelled so that its work stops at the next stage boundary. (A client that half-closes its
+// sending side after the request therefore counts as gone; HTTP/1.1 clients do not do that.)
 #pragma once
 
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ssl/stream.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core/flat_buffer.hpp>
+#include <boost/beast/core/stream_traits.hpp>
 #include <boost/beast/http/empty_body.hpp>
 #include <boost/beast/http/parser.hpp>
 #include <chrono>
@@ -21,6 +31,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "server/http/byte_budget.h"
@@ -37,29 +48,37 @@ struct HttpObserver {
   std::function<void(int)> on_open_connections;    // gauge
 };
 
+using PlainStream = boost::asio::ip::tcp::socket;
+using TlsStream = boost::asio::ssl::stream<boost::asio::ip::tcp::socket>;
+
 // What all connections of one server share; the server owns it and outlives every connection.
 struct SessionContext {
-  SessionContext(HttpLimits limits_in, Router router_in, HttpObserver observer_in, int retry_after)
+  SessionContext(HttpLimits limits_in, Router router_in, HttpObserver observer_in, int retry_after,
+                 Authorizer authorizer_in = {})
       : limits(limits_in),
         router(std::move(router_in)),
         observer(std::move(observer_in)),
+        authorizer(std::move(authorizer_in)),
         budget(limits_in.max_buffered_bytes),
         retry_after_s(retry_after) {}
 
   const HttpLimits limits;
   const Router router;
   const HttpObserver observer;
+  const Authorizer authorizer;  // asked for every routed request, from its header
   ByteBudget budget;
   const int retry_after_s;            // Retry-After of the 503 refusals
   std::atomic<int> in_flight{0};      // requests handed to a handler and not yet answered
   std::atomic<bool> stopping{false};  // finish the current response, then close
 };
 
-class HttpSession : public std::enable_shared_from_this<HttpSession> {
+template <class Stream>
+class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
  public:
   using Socket = boost::asio::ip::tcp::socket;
+  static constexpr bool kTls = std::is_same_v<Stream, TlsStream>;
 
-  HttpSession(Socket socket, std::string peer, ConnectionLimiter::Ticket ticket,
+  HttpSession(Stream stream, std::string peer, ConnectionLimiter::Ticket ticket,
               SessionContext& context);
   HttpSession(const HttpSession&) = delete;
   HttpSession& operator=(const HttpSession&) = delete;
@@ -74,6 +93,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   using Parser = beast_http::request_parser<beast_http::string_body>;
   enum class After { kKeepAlive, kClose };
 
+  // TLS: the handshake, under the request deadline, then `next`; plain TCP: `next` at once.
+  void Handshake(std::function<void()> next);
   void WaitForRequest();
   void BeginRequest();
   void OnHeader(boost::beast::error_code ec);
@@ -82,6 +103,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void OnReadError(boost::beast::error_code ec);
   void Dispatch();
   void OnHandlerResponse(Response response);
+  // The read that notices a client leaving while its request is handled; after the answer is
+  // written it doubles as the wait for the next request (see OnWatch).
+  void Watch();
+  void OnWatch(boost::beast::error_code ec, size_t bytes);
+  Socket& socket() { return boost::beast::get_lowest_layer(stream_); }
 
   // Logs and counts; then answers with the refusal's status (when it has one) and closes.
   void RefuseAndClose(RefusalReason reason, std::string message);
@@ -100,7 +126,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void ArmDeadline(Clock::duration from_now) { ArmDeadline(Clock::now() + from_now); }
   bool TakeExpired();
 
-  Socket socket_;
+  Stream stream_;
   boost::asio::steady_timer deadline_;
   bool expired_ = false;
   const std::string peer_;
@@ -120,7 +146,14 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   bool keep_alive_ = true;
   bool awaiting_handler_ = false;  // a handler has the request and has not answered
   bool in_flight_ = false;         // counted in context_.in_flight until the answer is written
-  int requests_ = 0;               // answered on this connection
+  bool watching_ = false;          // the Watch() read is pending
+  bool writing_ = false;           // a response is being written
+  bool closed_ = false;
+  std::shared_ptr<Cancellation> client_gone_;  // of the request a handler has
+  int requests_ = 0;                           // answered on this connection
 };
+
+extern template class HttpSession<PlainStream>;
+extern template class HttpSession<TlsStream>;
 
 }  // namespace tod::server::http

@@ -5,8 +5,12 @@
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
+
+#include "server/core/cancellation.h"
 
 namespace tod::server::http {
 
@@ -18,7 +22,13 @@ using Response = beast_http::response<beast_http::string_body>;
 struct IncomingRequest {
   Request message;   // header and the whole body, already bounded by the transport's limits
   std::string peer;  // client address
+  // Cancelled (kClientDisconnected) when the client closes its connection before the answer.
+  std::shared_ptr<Cancellation> client_gone;
 };
+
+// Decides whether a request may go on, from its header alone (before its body is read): nullopt
+// to go on, or the message of a 401 refusal. Empty function: every request goes on.
+using Authorizer = std::function<std::optional<std::string>(const Request& header)>;
 
 // Answers one request. Call it exactly once, from any thread (the transport moves the write onto
 // the connection's own strand); it keeps the connection alive until the response is written.

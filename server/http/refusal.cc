@@ -30,6 +30,10 @@ const char* RefusalReasonName(RefusalReason reason) {
       return "write_timeout";
     case RefusalReason::kInternal:
       return "internal";
+    case RefusalReason::kUnauthenticated:
+      return "unauthenticated";
+    case RefusalReason::kTlsHandshake:
+      return "tls_handshake";
   }
   return "unknown";
 }
@@ -56,8 +60,11 @@ unsigned RefusalHttpStatus(RefusalReason reason) {
       return 405;
     case RefusalReason::kInternal:
       return 500;
+    case RefusalReason::kUnauthenticated:
+      return 401;
     case RefusalReason::kIdleTimeout:
     case RefusalReason::kWriteTimeout:
+    case RefusalReason::kTlsHandshake:
       return 0;
   }
   return 500;
@@ -84,6 +91,10 @@ const char* RefusalCodeName(RefusalReason reason) {
       return "UNIMPLEMENTED";
     case RefusalReason::kInternal:
       return "INTERNAL";
+    case RefusalReason::kUnauthenticated:
+      return "UNAUTHENTICATED";
+    case RefusalReason::kTlsHandshake:
+      return "UNAVAILABLE";
   }
   return "UNKNOWN";
 }

@@ -20,6 +20,8 @@ enum class RefusalReason {
   kMethodNotAllowed,             // 405 (+ Allow): the path exists, the method does not
   kWriteTimeout,                 // no reply: the client did not read its response
   kInternal,                     // 500: a handler threw
+  kUnauthenticated,              // 401 (+ WWW-Authenticate): no or no valid bearer token
+  kTlsHandshake,                 // no reply: the TLS handshake failed or did not finish in time
 };
 
 // Stable snake_case name: the `reason` label of tod_http_refused_total and the log field.

@@ -146,3 +146,37 @@ TEST(ConfigTest, HttpLimitsComeFromEverySourceAndAreRangeChecked) {
 
 }  // namespace
 }  // namespace tod::server
+
+namespace tod::server {
+namespace {
+
+TEST(ConfigTest, TlsAndTokenFilesComeFromFileEnvironmentAndFlags) {
+  const std::string file =
+      WriteTempFile("tod_config_tls.json",
+                    R"({"model": "/m", "tls_cert": "/file/cert.pem", "tls_key": "/file/key.pem",
+          "auth_token_file": "/file/tokens"})");
+  const Result<ServerConfig> config = ResolveServerConfig(
+      {{"config", file}, {"tls_key", "/flag/key.pem"}},
+      FakeEnv({{"TOD_TLS_CLIENT_CA", "/env/ca.pem"}, {"TOD_AUTH_TOKEN_FILE", "/env/tokens"}}));
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  EXPECT_EQ(config->tls_cert, "/file/cert.pem");
+  EXPECT_EQ(config->tls_key, "/flag/key.pem");
+  EXPECT_EQ(config->tls_client_ca, "/env/ca.pem");
+  EXPECT_EQ(config->auth_token_file, "/env/tokens");
+  const nlohmann::json json = ServerConfigToJson(*config);
+  EXPECT_EQ(json["auth_token_file"], "/env/tokens");
+}
+
+TEST(ConfigTest, HalfATlsConfigurationIsRefused) {
+  const auto cert_only =
+      ResolveServerConfig({{"model", "/m"}, {"tls_cert", "/c.pem"}}, FakeEnv({}));
+  ASSERT_FALSE(cert_only.ok());
+  EXPECT_NE(cert_only.status().message().find("tls_key"), std::string::npos);
+  const auto ca_only =
+      ResolveServerConfig({{"model", "/m"}, {"tls_client_ca", "/ca.pem"}}, FakeEnv({}));
+  ASSERT_FALSE(ca_only.ok());
+  EXPECT_NE(ca_only.status().message().find("tls_client_ca"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace tod::server

@@ -142,9 +142,19 @@ TEST(DeployTest, RenderedManifestsAreConsistent) {
   auto is_container_port = [&](const std::string& port) {
     return port_names.count(port) > 0 || port_numbers.count(port) > 0;
   };
-  // Probes: gRPC readiness, HTTP liveness, a startup probe; all on ports the container exposes.
-  EXPECT_TRUE(port_numbers.count(container.Str("readinessProbe.grpc.port")))
-      << "gRPC readiness probe port must be a container port number";
+  // Probes: readiness, liveness, a startup probe; all on ports the container exposes. With TLS
+  // on, kubelet's gRPC probe cannot connect: every probe is then HTTPS.
+  const bool tls = !container.Str("readinessProbe.httpGet.scheme").empty() ||
+                   container.Path("readinessProbe.grpc") == nullptr;
+  if (tls) {
+    EXPECT_EQ(container.Str("readinessProbe.httpGet.scheme"), "HTTPS");
+    EXPECT_TRUE(is_container_port(container.Str("readinessProbe.httpGet.port")));
+    EXPECT_EQ(container.Str("livenessProbe.httpGet.scheme"), "HTTPS");
+    EXPECT_EQ(container.Str("startupProbe.httpGet.scheme"), "HTTPS");
+  } else {
+    EXPECT_TRUE(port_numbers.count(container.Str("readinessProbe.grpc.port")))
+        << "gRPC readiness probe port must be a container port number";
+  }
   EXPECT_TRUE(is_container_port(container.Str("livenessProbe.httpGet.port")));
   EXPECT_EQ(container.Str("livenessProbe.httpGet.path"), "/v2/health/live");
   const std::string startup_port =
@@ -194,6 +204,53 @@ TEST(DeployTest, RenderedManifestsAreConsistent) {
   const YamlNode* pdb = FindKind(docs, "PodDisruptionBudget");
   ASSERT_NE(pdb, nullptr);
   EXPECT_TRUE(LabelsContain(pod_labels, pdb->Path("spec.selector.matchLabels")));
+}
+
+// TLS files and tokens come from Secrets mounted read-only where the server's flags point, and
+// the probes (which cannot present tokens or speak gRPC over TLS) use HTTPS on open paths.
+TEST(DeployTest, DeploymentMountsTlsAndTokensFromSecrets) {
+  const auto docs = ParseYamlDocuments(ReadText(SourceDir() + "/deploy/k8s/deployment.yaml"));
+  ASSERT_TRUE(docs.ok()) << docs.status().message();
+  const YamlNode* pod = (*docs)[0].Path("spec.template.spec");
+  ASSERT_NE(pod, nullptr);
+  const YamlNode& container = pod->Get("containers")->items.at(0);
+  std::map<std::string, std::string> flags;  // --name=value
+  for (const YamlNode& arg : container.Get("args")->items) {
+    const size_t equals = arg.scalar.find('=');
+    if (equals != std::string::npos)
+      flags[arg.scalar.substr(0, equals)] = arg.scalar.substr(equals + 1);
+  }
+  std::map<std::string, std::string> secret_of_volume;
+  for (const YamlNode& volume : pod->Get("volumes")->items) {
+    if (!volume.Str("secret.secretName").empty()) {
+      secret_of_volume[volume.Str("name")] = volume.Str("secret.secretName");
+    }
+  }
+  // Each file flag points into a read-only mount of a Secret volume.
+  auto secret_for = [&](const std::string& path) -> std::string {
+    for (const YamlNode& mount : container.Get("volumeMounts")->items) {
+      const std::string dir = mount.Str("mountPath") + "/";
+      if (path.rfind(dir, 0) != 0) continue;
+      EXPECT_EQ(mount.Str("readOnly"), "true") << dir;
+      const auto secret = secret_of_volume.find(mount.Str("name"));
+      return secret == secret_of_volume.end() ? "" : secret->second;
+    }
+    return "";
+  };
+  for (const char* flag : {"--tls-cert", "--tls-key", "--auth-token-file"}) {
+    ASSERT_TRUE(flags.count(flag)) << flag << " missing from the container args";
+    EXPECT_FALSE(secret_for(flags[flag]).empty()) << flag << " is not on a mounted Secret";
+  }
+  EXPECT_EQ(secret_for(flags["--tls-cert"]), secret_for(flags["--tls-key"]));
+  EXPECT_NE(secret_for(flags["--tls-cert"]), secret_for(flags["--auth-token-file"]));
+  // The non-root user can read the Secret files.
+  EXPECT_EQ(pod->Str("securityContext.fsGroup"), pod->Str("securityContext.runAsGroup"));
+  // Probes stay on the open paths, over HTTPS.
+  for (const char* probe : {"readinessProbe", "livenessProbe", "startupProbe"}) {
+    const std::string prefix = std::string(probe) + ".httpGet.";
+    EXPECT_EQ(container.Str(prefix + "scheme"), "HTTPS") << probe;
+    EXPECT_EQ(container.Str(prefix + "path").rfind("/v2/health/", 0), 0u) << probe;
+  }
 }
 
 TEST(DeployTest, DockerfileFollowsTheContract) {

@@ -257,3 +257,119 @@ TEST(ModelHolderTest, FailedLoadKeepsTheCurrentModel) {
 
 }  // namespace
 }  // namespace tod::server
+
+namespace tod::server {
+namespace {
+
+using testing::GatedDetector;
+
+class EngineCancellationTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    detector_ = std::make_shared<GatedDetector>("v1", /*open=*/false);
+    models_.Install(detector_, "/models/one");
+    EngineConfig config;
+    config.workers = 1;
+    config.queue_capacity = 4;
+    engine_ = std::make_unique<InferenceEngine>(config, models_, &metrics_);
+    engine_->Start();
+  }
+  InferenceRequest Request(std::shared_ptr<Cancellation> cancellation = nullptr) {
+    InferenceRequest request;
+    request.image = image_;
+    request.cancellation = std::move(cancellation);
+    return request;
+  }
+  double Cancelled(const std::string& reason) {
+    const std::string text = metrics_.SerializeText();
+    const std::string series = "tod_requests_cancelled_total{reason=\"" + reason + "\"} ";
+    const size_t at = text.find(series);
+    return at == std::string::npos ? -1 : std::stod(text.substr(at + series.size()));
+  }
+  struct Waiter {
+    std::promise<InferenceResult> promise;
+    std::future<InferenceResult> future = promise.get_future();
+    Completion callback() {
+      return [this](InferenceResult result) { promise.set_value(std::move(result)); };
+    }
+  };
+
+  const std::string image_ = testing::RoadPng();
+  std::shared_ptr<GatedDetector> detector_;
+  ModelHolder models_;
+  ServerMetrics metrics_;
+  std::unique_ptr<InferenceEngine> engine_;
+};
+
+TEST_F(EngineCancellationTest, RunningRequestStopsAtTheNextStageBoundary) {
+  auto cancellation = std::make_shared<Cancellation>();
+  Waiter running;
+  engine_->Submit(Request(cancellation), running.callback());
+  ASSERT_TRUE(detector_->WaitStarted(1));
+  cancellation->Cancel(CancelReason::kClientCancelled);
+  detector_->Open();  // the fake's one stage ends; its boundary sees the cancellation
+  const InferenceResult result = running.future.get();
+  EXPECT_EQ(result.status.code(), StatusCode::kCancelled) << result.status.ToString();
+  EXPECT_EQ(result.rejection, Rejection::kCancelled);
+  ASSERT_TRUE(result.cancelled.has_value());
+  EXPECT_EQ(*result.cancelled, CancelReason::kClientCancelled);
+  EXPECT_EQ(Cancelled("client_cancelled"), 1);
+  EXPECT_EQ(Cancelled("drain"), 0);
+}
+
+TEST_F(EngineCancellationTest, QueuedRequestOfAGoneClientIsSkipped) {
+  Waiter running, queued;
+  engine_->Submit(Request(), running.callback());
+  ASSERT_TRUE(detector_->WaitStarted(1));
+  auto cancellation = std::make_shared<Cancellation>();
+  engine_->Submit(Request(cancellation), queued.callback());
+  cancellation->Cancel(CancelReason::kClientDisconnected);
+  detector_->Open();
+  EXPECT_TRUE(running.future.get().status.ok());
+  const InferenceResult skipped = queued.future.get();
+  EXPECT_EQ(skipped.status.code(), StatusCode::kCancelled);
+  EXPECT_EQ(detector_->started(), 1) << "the gone client's request must not run";
+  EXPECT_EQ(Cancelled("client_disconnected"), 1);
+}
+
+TEST_F(EngineCancellationTest, CancelAllAnswersQueuedAtOnceAndStopsRunning) {
+  Waiter running, queued1, queued2;
+  engine_->Submit(Request(), running.callback());
+  ASSERT_TRUE(detector_->WaitStarted(1));
+  engine_->Submit(Request(), queued1.callback());
+  engine_->Submit(Request(), queued2.callback());
+  engine_->BeginDrain();
+  engine_->CancelAll(CancelReason::kDrain);
+  // Queued ones are answered before the running one ends.
+  for (Waiter* queued : {&queued1, &queued2}) {
+    ASSERT_EQ(queued->future.wait_for(std::chrono::seconds(0)), std::future_status::ready);
+    const InferenceResult result = queued->future.get();
+    EXPECT_EQ(result.status.code(), StatusCode::kUnavailable);
+    EXPECT_EQ(result.cancelled, CancelReason::kDrain);
+  }
+  EXPECT_EQ(engine_->queue_depth(), 0u);
+  detector_->Open();
+  const InferenceResult stopped = running.future.get();
+  EXPECT_EQ(stopped.status.code(), StatusCode::kUnavailable) << stopped.status.ToString();
+  EXPECT_TRUE(engine_->WaitIdle(std::chrono::steady_clock::now() + std::chrono::seconds(60)));
+  EXPECT_EQ(Cancelled("drain"), 3);
+  EXPECT_EQ(detector_->started(), 1);
+}
+
+TEST_F(EngineCancellationTest, DeadlinePassingWhileRunningStopsTheWork) {
+  InferenceRequest request = Request();
+  request.deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(1);
+  Waiter running;
+  // Submitted while the gate is closed: the worker takes it at once (before the deadline, most
+  // likely) or after (then it is skipped); either way it ends DEADLINE_EXCEEDED, never OK.
+  engine_->Submit(request, running.callback());
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  detector_->Open();
+  const InferenceResult result = running.future.get();
+  EXPECT_EQ(result.status.code(), StatusCode::kDeadlineExceeded);
+  EXPECT_EQ(result.rejection, Rejection::kDeadline);
+  EXPECT_EQ(Cancelled("deadline"), 1);
+}
+
+}  // namespace
+}  // namespace tod::server

@@ -27,6 +27,10 @@ class GatedDetector : public Detector {
       changed_.notify_all();
       changed_.wait(lock, [this] { return open_; });
     }
+    // One stage boundary, after the gate: a request cancelled while it waited stops here.
+    if (options.cancelled) {
+      if (Status stop = options.cancelled(); !stop.ok()) return stop;
+    }
     Detection detection;
     detection.width = bgr.cols;
     detection.height = bgr.rows;

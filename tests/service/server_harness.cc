@@ -103,8 +103,10 @@ ProcessResult RunCommand(const std::vector<std::string>& argv) {
 }
 
 std::unique_ptr<ServerProcess> ServerProcess::Start(const std::string& model_dir,
-                                                    const std::vector<std::string>& extra_args) {
+                                                    const std::vector<std::string>& extra_args,
+                                                    HarnessTls tls) {
   std::unique_ptr<ServerProcess> server(new ServerProcess());
+  server->tls_ = std::move(tls);
   server->grpc_port_ = FreeLoopbackPort();
   do {
     server->http_port_ = FreeLoopbackPort();
@@ -134,11 +136,12 @@ ServerProcess::~ServerProcess() {
 
 bool ServerProcess::WaitReady(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  httplib::Client client("127.0.0.1", http_port_);
-  client.set_connection_timeout(std::chrono::milliseconds(200));
+  const std::unique_ptr<httplib::Client> client = HttpClient();
+  client->set_connection_timeout(std::chrono::milliseconds(200));
   while (std::chrono::steady_clock::now() < deadline) {
     if (WaitExit(std::chrono::milliseconds(0))) return false;
-    if (const auto response = client.Get("/v2/health/ready"); response && response->status == 200) {
+    if (const auto response = client->Get("/v2/health/ready");
+        response && response->status == 200) {
       return true;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -165,6 +168,31 @@ std::optional<int> ServerProcess::WaitExit(std::chrono::milliseconds timeout) {
 }
 
 std::string ServerProcess::Log() const { return ReadAll(log_path_); }
+
+std::unique_ptr<httplib::Client> ServerProcess::HttpClient() const {
+  const std::string address = "127.0.0.1:" + std::to_string(http_port_);
+  if (tls_.ca_cert.empty()) return std::make_unique<httplib::Client>("http://" + address);
+  auto client =
+      std::make_unique<httplib::Client>("https://" + address, tls_.client_cert, tls_.client_key);
+  client->set_ca_cert_path(tls_.ca_cert.c_str());
+  client->enable_server_certificate_verification(true);
+  return client;
+}
+
+std::string ServerProcess::Metrics() const {
+  const auto response = HttpClient()->Get("/metrics");
+  return response && response->status == 200 ? response->body : "";
+}
+
+bool ServerProcess::WaitForMetric(const std::string& series, double value,
+                                  std::chrono::milliseconds timeout) const {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (MetricValue(Metrics(), series).value_or(-1) >= value) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
 
 std::string ScrapeMetrics(int http_port) {
   httplib::Client client("127.0.0.1", http_port);

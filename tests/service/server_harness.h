@@ -11,7 +11,18 @@
 #include <string>
 #include <vector>
 
+namespace httplib {
+class Client;
+}  // namespace httplib
+
 namespace tod::server::testing {
+
+// How the harness's own HTTP client reaches a server started with TLS (empty: plain HTTP).
+struct HarnessTls {
+  std::string ca_cert;
+  std::string client_cert;  // for servers that require client certificates
+  std::string client_key;
+};
 
 // A TCP port on 127.0.0.1 that was free a moment ago.
 int FreeLoopbackPort();
@@ -37,7 +48,8 @@ class ServerProcess {
  public:
   // Starts tod_server --model DIR on two free loopback ports plus `extra_args`.
   static std::unique_ptr<ServerProcess> Start(const std::string& model_dir,
-                                              const std::vector<std::string>& extra_args);
+                                              const std::vector<std::string>& extra_args,
+                                              HarnessTls tls = {});
   ~ServerProcess();  // SIGKILL if still running
 
   // Polls GET /v2/health/ready until 200; false if the process exits or `timeout` passes.
@@ -46,6 +58,13 @@ class ServerProcess {
   // Exit code once the process ends (within `timeout`), else nullopt.
   std::optional<int> WaitExit(std::chrono::milliseconds timeout);
   std::string Log() const;
+  // An HTTP(S) client of this server's REST port (HTTPS with the harness's TLS files).
+  std::unique_ptr<httplib::Client> HttpClient() const;
+  // GET /metrics through HttpClient() ("" on failure).
+  std::string Metrics() const;
+  // Polls the metrics until `series` is at least `value`; false after `timeout`.
+  bool WaitForMetric(const std::string& series, double value,
+                     std::chrono::milliseconds timeout = std::chrono::seconds(60)) const;
 
   pid_t pid() const { return pid_; }
   int grpc_port() const { return grpc_port_; }
@@ -59,6 +78,7 @@ class ServerProcess {
   int http_port_ = 0;
   std::string log_path_;
   std::optional<int> exit_code_;
+  HarnessTls tls_;
 };
 
 // GET /metrics from the server as text ("" on failure).

@@ -194,7 +194,10 @@ TEST_F(ServiceE2ETest, ModelInfoHealthAndMetrics) {
   tod::v1::ModelInfo info;
   ASSERT_TRUE(grpc_->GetModelInfo(&info).ok());
   EXPECT_EQ(info.generation(), 1);
-  EXPECT_EQ(info.model_dir(), TestModel());
+  // The bundle's name, never the server's path.
+  EXPECT_EQ(info.model_dir(), fs::path(TestModel()).filename().string());
+  EXPECT_EQ(info.model_dir(), info.name());
+  EXPECT_EQ(info.manifest_json().find(TestModel()), std::string::npos);
   EXPECT_FALSE(info.manifest_json().empty());
   const auto rest = http_->Get("/v1/model");
   ASSERT_TRUE(rest);
@@ -202,6 +205,7 @@ TEST_F(ServiceE2ETest, ModelInfoHealthAndMetrics) {
   const nlohmann::json json = nlohmann::json::parse(rest->body);
   EXPECT_EQ(json["version"], info.version());
   EXPECT_EQ(json["name"], info.name());
+  EXPECT_EQ(rest->body.find(TestModel()), std::string::npos) << rest->body;
 
   grpc::health::v1::HealthCheckResponse health;
   ASSERT_TRUE(grpc_->Health("", &health).ok());

@@ -4,6 +4,7 @@
 #include <httplib.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -32,6 +33,13 @@ const std::string& BusyFrame() {
   return frame;
 }
 
+// A frame that takes the tiny model a good part of a second or more: work that queued requests
+// surely wait behind, even on a loaded machine.
+const std::string& LongFrame() {
+  static const std::string frame = testing::RoadPng(1600, 800);
+  return frame;
+}
+
 tod::v1::DetectRequest Request(const std::string& image) {
   tod::v1::DetectRequest request;
   request.set_image(image);
@@ -39,18 +47,10 @@ tod::v1::DetectRequest Request(const std::string& image) {
   return request;
 }
 
-// Milliseconds one busy frame takes end to end (also warms the server up).
-double TimeBusyFrame(client::TodGrpcClient& client) {
-  const auto start = std::chrono::steady_clock::now();
-  tod::v1::DetectResponse response;
-  EXPECT_TRUE(client.Detect(Request(BusyFrame()), &response).ok());
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
-// Polls the server's metrics until `series` reaches `value` (true) or 20 s pass (false).
+// Polls the server's metrics until `series` reaches `value` (true) or 60 s pass (false): a bound
+// for a broken server, not a timing assumption.
 bool WaitForMetric(int http_port, const std::string& series, double value) {
-  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
   while (std::chrono::steady_clock::now() < deadline) {
     if (MetricValue(ScrapeMetrics(http_port), series).value_or(-1) >= value) return true;
     std::this_thread::sleep_for(2ms);
@@ -71,7 +71,8 @@ TEST(ServiceLifecycleTest, QueueOverflowGives503WithRetryAfterAndEverythingElse2
       httplib::Client client("127.0.0.1", port);
       client.set_read_timeout(120s);
       while (!go) std::this_thread::yield();
-      const auto result = client.Post("/v1/detect?map=none", BusyFrame(), "image/png");
+      // Long frames: the burst overflows 1 worker + 1 slot even when its senders start slowly.
+      const auto result = client.Post("/v1/detect?map=none", LongFrame(), "image/png");
       if (!result) return std::make_pair(-1, std::string());
       return std::make_pair(result->status, result->get_header_value("Retry-After"));
     }));
@@ -100,24 +101,32 @@ TEST(ServiceLifecycleTest, QueueOverflowGives503WithRetryAfterAndEverythingElse2
   EXPECT_EQ(after->status, 200);
 }
 
+// Was timing-dependent (failed once on a busy 2-core machine): the late requests' deadline was a
+// quarter of a small frame's time, a few tens of ms, which a loaded machine can spend before the
+// request even reaches the server. Now the deadline is at least 1 s, and enough long frames are
+// queued ahead that the late requests wait at least four times their deadline.
 TEST(ServiceLifecycleTest, DeadlinePassedInQueueIsSkipped) {
   REQUIRE_MODEL();
   auto server = ServerProcess::Start(TestModel(), {"--workers", "1", "--queue", "8"});
   ASSERT_TRUE(server->WaitReady()) << server->Log();
   client::TodGrpcClient client(server->grpc_address());
-  // The first frame also pays one-off warm-up costs: time the second.
-  TimeBusyFrame(client);
-  const double busy_ms = TimeBusyFrame(client);
-  // Three busy frames ahead: anything queued behind them waits about two busy frames or more.
+  // One long frame: warms up and measures (its decode is counted below).
+  const auto start = std::chrono::steady_clock::now();
+  tod::v1::DetectResponse warm;
+  ASSERT_TRUE(client.Detect(Request(LongFrame()), &warm).ok());
+  const double long_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const auto timeout = std::chrono::milliseconds(std::max(1000, static_cast<int>(long_ms / 2)));
+  // Frames ahead: the first runs, the late requests wait for all of them to finish.
+  const int frames_ahead = std::clamp(static_cast<int>(4 * timeout.count() / long_ms) + 2, 3, 6);
   std::vector<std::future<grpc::Status>> ahead;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < frames_ahead; ++i) {
     ahead.push_back(std::async(std::launch::async, [&] {
       tod::v1::DetectResponse response;
-      return client.Detect(Request(BusyFrame()), &response);
+      return client.Detect(Request(LongFrame()), &response);
     }));
   }
-  ASSERT_TRUE(WaitForMetric(server->http_port(), "tod_in_flight_requests", 3));
-  const auto timeout = std::chrono::milliseconds(std::max(1, static_cast<int>(busy_ms / 4)));
+  ASSERT_TRUE(WaitForMetric(server->http_port(), "tod_in_flight_requests", frames_ahead));
   auto late_grpc = std::async(std::launch::async, [&] {
     tod::v1::DetectResponse response;
     return client.Detect(Request(testing::RoadPng()), &response, timeout);
@@ -135,11 +144,13 @@ TEST(ServiceLifecycleTest, DeadlinePassedInQueueIsSkipped) {
   EXPECT_EQ(late_http.get(), 504);
   for (auto& status : ahead) EXPECT_TRUE(status.get().ok());
   // Both late requests were dropped at dequeue: counted as deadline rejections and never decoded
-  // (decode ran for the two warm-up frames and the three frames ahead only).
+  // (decode ran for the warm-up frame and the frames ahead only).
   ASSERT_TRUE(WaitForMetric(server->http_port(), R"(tod_rejections_total{reason="deadline"})", 2));
   const std::string metrics = ScrapeMetrics(server->http_port());
-  EXPECT_EQ(MetricValue(metrics, R"(tod_stage_duration_seconds_count{stage="decode"})"), 5)
+  EXPECT_EQ(MetricValue(metrics, R"(tod_stage_duration_seconds_count{stage="decode"})"),
+            1 + frames_ahead)
       << metrics;
+  EXPECT_EQ(MetricValue(metrics, R"(tod_requests_cancelled_total{reason="deadline"})"), 2);
   tod::v1::DetectResponse response;
   EXPECT_TRUE(client.Detect(Request(testing::RoadPng()), &response).ok());
 }
