@@ -42,7 +42,7 @@ TEST(FrameGeometryTest, WiderAspectScalesByWidthAndKeepsRowsAboutTheCentre) {
   const FrameGeometry g = GeometryForFrame(BundleAt2048x1024(), 1920, 1080);
   EXPECT_EQ(g.regions.image_width, 1920);
   EXPECT_EQ(g.regions.image_height, 1080);
-  EXPECT_EQ(g.regions.layers[0], (Box{0, 435, 1920, 585}));  // 400*0.9375+60 = 435, clipped
+  EXPECT_EQ(g.regions.layers[0], (Box{0, 435, 1920, 585}));   // 400*0.9375+60 = 435, clipped
   EXPECT_EQ(g.regions.layers[1], (Box{480, 481, 960, 189}));  // floor / ceil outward
   const SizeBand& b = g.size_filter.bands[0];
   EXPECT_DOUBLE_EQ(b.center_y_min, 412 * 0.9375 + 60);
