@@ -10,6 +10,13 @@
 
 namespace tod {
 
+// Ok when i indexes a dataset of `size` frames; else the error every reader returns.
+inline Status CheckFrameIndex(std::size_t i, std::size_t size) {
+  if (i < size) return Status::Ok();
+  return Status::InvalidArgument("frame index " + std::to_string(i) + " out of range (" +
+                                 std::to_string(size) + " frames)");
+}
+
 class Dataset {
  public:
   virtual ~Dataset() = default;

@@ -177,10 +177,7 @@ class LafDataset final : public Dataset {
   }
 
   Result<Sample> Load(std::size_t i) const override {
-    if (i >= frames_.size()) {
-      return Status::InvalidArgument("frame index " + std::to_string(i) + " out of range (" +
-                                     std::to_string(frames_.size()) + " frames)");
-    }
+    if (Status st = CheckFrameIndex(i, frames_.size()); !st.ok()) return st;
     const LafFrame& frame = frames_[i];
     // IMREAD_COLOR gives BGR 8-bit whatever the PNG holds; the gamma chunk is not applied
     // (ALGORITHM.md §9.1: decode raw values).

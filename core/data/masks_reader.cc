@@ -111,10 +111,7 @@ class MasksDataset final : public Dataset {
   }
 
   Result<Sample> Load(std::size_t i) const override {
-    if (i >= frames_.size()) {
-      return Status::InvalidArgument("frame index " + std::to_string(i) + " out of range (" +
-                                     std::to_string(frames_.size()) + " frames)");
-    }
+    if (Status st = CheckFrameIndex(i, frames_.size()); !st.ok()) return st;
     const MaskFrame& frame = frames_[i];
     Result<cv::Mat> image = ReadImageFile(frame.image, cv::IMREAD_COLOR, "image");
     if (!image.ok()) return image.status();

@@ -5,7 +5,6 @@
 #include <mutex>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
-#include <optional>
 #include <sstream>
 
 #include "core/features/sample_selection.h"
@@ -76,13 +75,16 @@ FrameResult AnalyseFrame(const ModelBundle& bundle, const Sample& s,
   std::vector<ScoredBox> unfiltered;
   std::vector<std::vector<ScoredBox>> filtered(layers);
   const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
+  long long windows_scored = 0;  // as the detector scores them (size filter admission on)
   for (int k = 0; k < layers; ++k) {
+    EdgeBoxStats unfiltered_stats, stats;
     const auto all = ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k,
-                                        bundle.params.multistride, nullptr);
+                                        bundle.params.multistride, nullptr, &unfiltered_stats);
     unfiltered.insert(unfiltered.end(), all.begin(), all.end());
     filtered[k] = filter ? ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k,
-                                              bundle.params.multistride, filter)
+                                              bundle.params.multistride, filter, &stats)
                          : all;
+    windows_scored += (filter ? stats : unfiltered_stats).windows_visited;
   }
   ProposalSet merged = MergeRegionBoxes(filtered, bundle.params.region_merge_iou);
   std::vector<Box> by_objectness;
@@ -101,20 +103,7 @@ FrameResult AnalyseFrame(const ModelBundle& bundle, const Sample& s,
   out.work.occlusion_density = Share(oaocc.occlusion);
   out.work.superpixels = oaocc.superpixels.count;
   out.work.proposals = static_cast<long long>(by_objectness.size());
-  for (int k = 0; k < layers; ++k) {
-    EdgeBoxStats stats;
-    EdgeBoxParams params = bundle.params.boxes;
-    params.refine = false;  // counting windows only
-    const cv::Mat1f map = RegionEdgeMap(oaocc, geo.regions, k);
-    if (map.empty()) continue;
-    params.stride_factor =
-        bundle.params.multistride ? static_cast<float>(layers - k) / layers : 1.f;
-    const Box region = Intersect(geo.regions.layers[k], oaocc.r1);
-    std::optional<WindowAdmission> admission;
-    if (filter && filter->enabled) admission.emplace(*filter, region.y);
-    ScoreEdgeBoxes(NormaliseToMax(map), params, &stats, admission ? &*admission : nullptr);
-    out.work.windows_scored += stats.windows_visited;
-  }
+  out.work.windows_scored = windows_scored;
 
   const cv::Mat1b base_near = EdgesDilatedByOne(oaocc.base_edge);
   const cv::Mat1b occlusion_near = EdgesDilatedByOne(oaocc.occlusion);
