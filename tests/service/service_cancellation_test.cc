@@ -87,6 +87,9 @@ TEST(ServiceCancellationTest, CancelledGrpcCallStopsItsWorkAndIsCounted) {
   ASSERT_TRUE(server->WaitForMetric(kCancelledClient, 1)) << server->Log();
   ASSERT_TRUE(server->WaitForMetric(R"(tod_requests_total{code="CANCELLED",protocol="grpc"})", 1))
       << server->Metrics();
+  // The in-flight gauge drops just after the request is counted: poll it (bounded), do not race.
+  for (int i = 0; i < 600 && Metric(*server, "tod_in_flight_requests") != 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
   const std::string metrics = server->Metrics();
   EXPECT_EQ(MetricValue(metrics, R"(tod_requests_total{code="OK",protocol="grpc"})"), 1)
       << "the cancelled call was logged as OK";
