@@ -32,6 +32,12 @@ const std::vector<SettingSpec>& SettingSpecs() {
       {"grpc_port", "grpc-port", "TOD_GRPC_PORT", "gRPC port (default 8001)"},
       {"http_port", "http-port", "TOD_HTTP_PORT", "REST port (default 8000)"},
       {"workers", "workers", "TOD_WORKERS", "Worker threads (default: number of cores)"},
+      {"threads_per_request", "threads-per-request", "TOD_THREADS_PER_REQUEST",
+       "Cores one request may use: window scans, features and regressors split over them "
+       "(default 1; workers x this should not exceed the cores)"},
+      {"frame_budget_ms", "frame-budget-ms", "TOD_FRAME_BUDGET_MS",
+       "Time a frame may take from decode to map, ms; past it, proposals and regression degrade "
+       "and the response says so (default 2000, 0: none)"},
       {"queue", "queue", "TOD_QUEUE", "Requests allowed to wait for a worker (default 64)"},
       {"max_image_bytes", "max-image-bytes", "TOD_MAX_IMAGE_BYTES",
        "Largest encoded image accepted, bytes (default 16 MiB)"},
@@ -84,6 +90,10 @@ Status ApplySetting(const std::string& key, const std::string& value, const std:
     return ParseNumber(value, what, &config->http_port);
   } else if (key == "workers") {
     return ParseNumber(value, what, &config->workers);
+  } else if (key == "threads_per_request") {
+    return ParseNumber(value, what, &config->threads_per_request);
+  } else if (key == "frame_budget_ms") {
+    return ParseNumber(value, what, &config->frame_budget_ms);
   } else if (key == "queue") {
     return ParseNumber(value, what, &config->queue);
   } else if (key == "max_image_bytes") {
@@ -195,6 +205,12 @@ Status ValidateServerConfig(const ServerConfig& config) {
   if (config.workers < 1 || config.workers > 1024) {
     return Status::InvalidArgument("workers: must be in 1..1024");
   }
+  if (config.threads_per_request < 1 || config.threads_per_request > 64) {
+    return Status::InvalidArgument("threads_per_request: must be in 1..64");
+  }
+  if (!(config.frame_budget_ms >= 0 && config.frame_budget_ms <= 600'000)) {
+    return Status::InvalidArgument("frame_budget_ms: must be in 0..600000 (0: no budget)");
+  }
   if (config.queue < 0) return Status::InvalidArgument("queue: must be >= 0");
   if (config.max_image_bytes < 64 || config.max_image_bytes > (1u << 30)) {
     return Status::InvalidArgument("max_image_bytes: must be in 64..1073741824");
@@ -260,6 +276,8 @@ nlohmann::json ServerConfigToJson(const ServerConfig& config) {
           {"grpc_port", config.grpc_port},
           {"http_port", config.http_port},
           {"workers", config.workers},
+          {"threads_per_request", config.threads_per_request},
+          {"frame_budget_ms", config.frame_budget_ms},
           {"queue", config.queue},
           {"max_image_bytes", config.max_image_bytes},
           {"max_image_pixels", config.max_image_pixels},

@@ -19,6 +19,8 @@ struct ServerConfig {
   int grpc_port = 8001;
   int http_port = 8000;
   int workers = 0;                     // 0: one per core
+  int threads_per_request = 1;         // cores one request may use
+  double frame_budget_ms = 2000;       // decode to map; 0: no budget
   int queue = 64;                      // requests waiting for a worker
   size_t max_image_bytes = 16u << 20;  // encoded request body
   // The shipped model's camera frames are 2048 x 1024 (2.1 MP); 4 MP leaves headroom while a

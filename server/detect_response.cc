@@ -23,6 +23,7 @@ RequestOptions OptionsFromProto(const tod::v1::DetectOptions& options) {
   if (options.has_min_obstacle_score()) {
     out.detect.min_obstacle_score = options.min_obstacle_score();
   }
+  if (options.has_budget_ms()) out.detect.budget_ms = options.budget_ms();
   out.encode_map_png = options.map_format() != tod::v1::MAP_FORMAT_NONE;
   out.detect.want_probability_map = out.encode_map_png;
   return out;
@@ -63,6 +64,8 @@ void FillDetectResponse(const InferenceResult& result, const std::string& frame_
     timing->set_ms(ms);
   }
   response->set_total_ms(result.total_ms);
+  response->set_degraded(detection.degraded());
+  for (const std::string& stage : detection.degraded_stages) response->add_degraded_stages(stage);
 }
 
 void FillModelInfo(const LoadedModel& model, tod::v1::ModelInfo* info) {

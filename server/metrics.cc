@@ -52,6 +52,10 @@ ServerMetrics::ServerMetrics()
                      .Help("Requests whose work was stopped at a stage boundary or skipped in "
                            "the queue, by reason")
                      .Register(*registry_)),
+      degraded_(prometheus::BuildCounter()
+                    .Name("tod_frames_degraded_total")
+                    .Help("Requests whose frame budget cut a stage short, by stage")
+                    .Register(*registry_)),
       http_refused_(prometheus::BuildCounter()
                         .Name("tod_http_refused_total")
                         .Help("Requests or connections the HTTP front end refused, by reason")
@@ -76,6 +80,7 @@ ServerMetrics::ServerMetrics()
   // Every reason from the start, so dashboards and alerts see 0 rather than no series.
   for (const CancelReason reason : kAllCancelReasons)
     cancelled_.Add({{"reason", CancelReasonName(reason)}});
+  for (const char* stage : {"proposals", "regression"}) degraded_.Add({{"stage", stage}});
 }
 
 void ServerMetrics::RecordRequest(const std::string& protocol, const std::string& code,
@@ -90,6 +95,10 @@ void ServerMetrics::RecordRejection(const std::string& reason) {
 
 void ServerMetrics::RecordCancelled(const std::string& reason) {
   cancelled_.Add({{"reason", reason}}).Increment();
+}
+
+void ServerMetrics::RecordDegraded(const std::string& stage) {
+  degraded_.Add({{"stage", stage}}).Increment();
 }
 
 void ServerMetrics::RecordHttpRefusal(const std::string& reason) {

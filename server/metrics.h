@@ -28,6 +28,8 @@ class ServerMetrics {
   // A request whose work was stopped or skipped because its caller gave up or the drain timeout
   // came: "deadline", "client_cancelled", "client_disconnected", "drain" (CancelReasonName).
   void RecordCancelled(const std::string& reason);
+  // The frame budget cut a stage of a request short ("proposals", "regression").
+  void RecordDegraded(const std::string& stage);
   void ObserveQueueWait(double seconds);
   void ObserveStages(const StageTimes& stages);  // milliseconds in, seconds exported
   void SetQueueDepth(double depth);
@@ -51,6 +53,7 @@ class ServerMetrics {
   prometheus::Gauge& in_flight_;
   prometheus::Family<prometheus::Counter>& rejections_;
   prometheus::Family<prometheus::Counter>& cancelled_;
+  prometheus::Family<prometheus::Counter>& degraded_;
   prometheus::Family<prometheus::Counter>& http_refused_;
   prometheus::Gauge& http_connections_;
   prometheus::Family<prometheus::Gauge>& model_info_;

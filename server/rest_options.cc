@@ -59,6 +59,11 @@ Status ParseDetectQuery(const QueryParams& query, InferenceRequest* inference,
   if (!min_score.ok()) return min_score.status();
   if (*min_score) inference->options.min_obstacle_score = static_cast<float>(**min_score);
 
+  const Result<std::optional<long long>> budget =
+      IntegerParam(query, "budget_ms", 1, kMaxRequestBudgetMs);
+  if (!budget.ok()) return budget.status();
+  if (*budget) inference->options.budget_ms = static_cast<double>(**budget);
+
   if (const auto map = query.find("map"); map != query.end()) {
     if (map->second == "none") {
       inference->encode_map_png = false;

@@ -1,6 +1,7 @@
 // The query parameters of POST /v1/detect and /v1/probability-map, parsed and range-checked:
 //   max_proposals  integer 0..10000        obstacle_threshold  number in [0, 1]
 //   map            png | none              timeout_ms          integer 0..3600000 (0: none)
+//   budget_ms      integer 1..600000 (lowers the server's frame budget)
 //   frame_id       text
 // A value out of range or not a number is an InvalidArgument naming the parameter; nothing can
 // overflow (numbers are parsed into wide types and checked before use).

@@ -149,6 +149,8 @@ int RunServer(const ServerConfig& config) {
   ModelHolder models;
   EngineConfig engine_config;
   engine_config.workers = config.workers;
+  engine_config.threads_per_request = config.threads_per_request;
+  engine_config.frame_budget_ms = config.frame_budget_ms;
   engine_config.queue_capacity = config.queue;
   engine_config.limits.max_bytes = config.max_image_bytes;
   engine_config.limits.max_pixels = config.max_image_pixels;

@@ -1,6 +1,7 @@
 // Wall-clock time of named pipeline stages, reported per frame from the start (issue: speed).
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <string>
@@ -27,6 +28,17 @@ class StageTimer {
     times_.emplace_back(std::move(stage),
                         std::chrono::duration<double, std::milli>(now - last_).count());
     last_ = now;
+    if (check_ && stopped_.ok()) stopped_ = check_();
+  }
+  // Records `stage` as taking `ms` of the time since the previous mark (at most all of it) and
+  // leaves the rest to the next Mark(): for two stages that ran interleaved. Asks the check.
+  void MarkPart(std::string stage, double ms) {
+    const double since_last =
+        std::chrono::duration<double, std::milli>(Clock::now() - last_).count();
+    const double part = std::clamp(ms, 0.0, since_last);
+    times_.emplace_back(std::move(stage), part);
+    last_ += std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double, std::milli>(part));
     if (check_ && stopped_.ok()) stopped_ = check_();
   }
   // OK until the check asked to stop; then the check's Status (Cancelled, DeadlineExceeded, ...).

@@ -5,6 +5,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
+#include "core/cli/request_options.h"
 #include "core/pipeline/frame_bench.h"
 #include "core/pipeline/model_bundle.h"
 #include "core/pipeline/obstacle_detector.h"
@@ -16,6 +17,7 @@ Runner AddBenchCommand(CLI::App& app) {
     std::string frames, model = "models/default", json;
     int limit = 0;
     int threads = 1;
+    DetectOptions detect;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -29,9 +31,9 @@ Runner AddBenchCommand(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--json", args->json, "also write the numbers and every frame's record here");
-  // --frame-budget-ms (issue 11) is added with the budget itself: it fills
-  // BenchOptions::detect like tod detect's and tod_server's.
+  AddFrameRequestOptions(cmd, &args->detect);
   return [args] {
+    UseRequestThreadsForOpenCv(args->detect);
     auto frames = ListBenchFrames(args->frames);
     if (!frames.ok()) return Fail(frames.status().message());
     if (frames->empty()) return Fail("no PNG, JPEG or WebP frame under " + args->frames);
@@ -44,6 +46,7 @@ Runner AddBenchCommand(CLI::App& app) {
 
     BenchOptions options;
     options.threads = args->threads;
+    options.detect = args->detect;
     options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
     std::cerr << "measuring " << frames->size() << " frames (after one warm-up)\n";
     auto report = RunFrameBench(detector, *frames, options);

@@ -8,6 +8,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
+#include "core/cli/request_options.h"
 #include "core/pipeline/detection_output.h"
 #include "core/pipeline/model_bundle.h"
 #include "core/pipeline/stage_images.h"
@@ -33,10 +34,12 @@ Runner AddDetectCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--max-proposals", args->options.max_proposals, "proposals listed in the JSON")
       ->check(CLI::NonNegativeNumber);
+  AddFrameRequestOptions(cmd, &args->options);
   cmd->add_flag(
       "--stages", args->stages,
       "also write each stage as PNG (STEM_stage_*.png) and its counts (STEM_stages.json)");
   return [args] {
+    UseRequestThreadsForOpenCv(args->options);
     auto detector = Detector::Load(args->model);
     if (!detector.ok()) return Fail(detector.status().message());
     // The Detector interface hides its bundle, so the stage pictures get their own copy of the

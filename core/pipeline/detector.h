@@ -22,6 +22,13 @@ struct DetectOptions {
   // an empty road reports no obstacle.
   float min_obstacle_score = 0.5f;
   bool want_probability_map = true;
+  // Frame budget in ms from the Detect call (frame_budget.h): past its stage shares, proposals
+  // and regression degrade in a defined way and Detection::degraded_stages names them. <= 0: no
+  // budget.
+  double budget_ms = 0;
+  // Cores this request may use: the window scans, features and regressors split their work
+  // over this many threads. The result does not depend on it (unless a budget cuts work short).
+  int threads = 1;
   // Asked between stages (after edges, superpixels, occlusion, proposals, features, regression);
   // when it returns a non-OK Status (Cancelled, DeadlineExceeded, ...) Detect stops and returns
   // it. A stage itself is never interrupted, so the hook only has to be cheap and thread-safe.
@@ -53,6 +60,9 @@ struct Detection {
   std::vector<DetectedObstacle> obstacles;
   cv::Mat1f probability;  // image size, [0,1]; empty unless requested
   StageTimes timings;     // per stage, in pipeline order, milliseconds
+  // Stages the frame budget cut short ("proposals", "regression"); empty: the full result.
+  std::vector<std::string> degraded_stages;
+  bool degraded() const { return !degraded_stages.empty(); }
 };
 
 struct ModelInfo {

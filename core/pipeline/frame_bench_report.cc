@@ -48,7 +48,14 @@ nlohmann::json RecordJson(const FrameBenchRecord& r) {
           {"windows_walked", r.windows_walked},
           {"edge_groups", r.edge_groups},
           {"edge_pixels", r.edge_pixels},
-          {"proposals", r.proposals}};
+          {"proposals", r.proposals},
+          {"degraded_stages", r.degraded_stages}};
+}
+
+int DegradedFrames(const FrameBenchReport& report) {
+  int n = 0;
+  for (const FrameBenchRecord& r : report.records) n += r.degraded_stages.empty() ? 0 : 1;
+  return n;
 }
 
 }  // namespace
@@ -58,6 +65,10 @@ std::string FormatBenchReport(const FrameBenchReport& report) {
   out << report.records.size() << " frames, model " << report.model << ", " << report.threads
       << (report.threads == 1 ? " thread" : " threads") << " (one frame per thread)";
   if (!report.skipped.empty()) out << ", " << report.skipped.size() << " skipped";
+  if (report.budget_ms > 0) {
+    out << ", frame budget " << Fixed(report.budget_ms, 0) << " ms (" << DegradedFrames(report)
+        << " frames degraded)";
+  }
   out << "\n\n";
   out << Header("stage (ms)");
   for (const auto& [stage, spread] : report.stages_ms) out << Row(stage, spread, 1);
@@ -70,6 +81,12 @@ std::string FormatBenchReport(const FrameBenchReport& report) {
       << "peak RSS: " << Fixed(report.peak_rss_mb, 1) << " MB\n";
   for (const SkippedFrame& f : report.skipped)
     out << "skipped " << f.frame << ": " << f.reason << "\n";
+  for (const FrameBenchRecord& r : report.records) {
+    if (r.degraded_stages.empty()) continue;
+    out << "degraded " << r.frame << ":";
+    for (const std::string& stage : r.degraded_stages) out << " " << stage;
+    out << "\n";
+  }
   return out.str();
 }
 
@@ -78,6 +95,8 @@ nlohmann::json BenchReportToJson(const FrameBenchReport& report) {
   j["frames"] = report.records.size();
   j["model"] = report.model;
   j["threads"] = report.threads;
+  j["frame_budget_ms"] = report.budget_ms;
+  j["degraded_frames"] = DegradedFrames(report);
   nlohmann::json stages = nlohmann::json::object();
   double proposals_median = 0;
   for (const auto& [stage, spread] : report.stages_ms) {

@@ -4,10 +4,10 @@
 #include <memory>
 #include <optional>
 
-#include "core/features/box_features.h"
-#include "core/features/colour_integrals.h"
+#include "core/pipeline/frame_budget.h"
 #include "core/pipeline/pipeline_params.h"
 #include "core/proposals/greedy_nms.h"
+#include "core/proposals/window_grid.h"
 
 namespace tod {
 
@@ -63,11 +63,7 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
   if (stats != nullptr) *stats = EdgeBoxStats{};
   const cv::Mat1f map = RegionEdgeMap(oaocc, regions, k);
   if (map.empty()) return {};
-  EdgeBoxParams params = box_params;
-  // §4.2.6: stride factor (K - k + 1) / K with paper index k = this k + 1.
-  const int num_layers = regions.num_layers();
-  params.stride_factor =
-      multistride ? static_cast<float>(num_layers - k) / static_cast<float>(num_layers) : 1.f;
+  const EdgeBoxParams params = RegionBoxParams(box_params, k, regions.num_layers(), multistride);
   const Box region = Intersect(regions.layers[k], oaocc.r1);
   std::vector<ScoredBox> out;
   const bool filtered = size_filter != nullptr && size_filter->enabled;
@@ -84,6 +80,14 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
     out.push_back(b);
   }
   return out;
+}
+
+EdgeBoxParams RegionBoxParams(const EdgeBoxParams& box_params, int k, int num_layers,
+                              bool multistride) {
+  EdgeBoxParams params = box_params;
+  params.stride_factor =
+      multistride ? static_cast<float>(num_layers - k) / static_cast<float>(num_layers) : 1.f;
+  return params;
 }
 
 ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region,
@@ -125,38 +129,32 @@ ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& r
                          const EdgeBoxParams& box_params, const ProposalOptions& options,
                          const SizeFilter& size_filter) {
   const int used = std::clamp(options.layers_used, 1, regions.num_layers());
-  std::vector<std::vector<ScoredBox>> per_region;
-  for (int k = 0; k < used; ++k)
-    per_region.push_back(ProposeRegionBoxes(oaocc, regions, box_params, k, options.multistride,
-                                            options.size_filter ? &size_filter : nullptr));
-  return MergeRegionBoxes(per_region, options.merge_iou);
-}
-
-cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
-                                  const MultilayerRegions& regions, const ProposalSet& proposals) {
-  cv::Mat1f rows(static_cast<int>(proposals.boxes.size()), kNumBoxFeatures, 0.f);
-  if (proposals.boxes.empty()) return rows;
-  // The colour integrals are built once for R1 and shared by every region (the regions are
-  // nested crops of R1); each region only adds its own edge map.
-  const auto frame_colour = std::make_shared<const ColourIntegrals>(
-      image(oaocc.r1.rect()), cv::Point(oaocc.r1.x, oaocc.r1.y));
-  for (int k = 0; k < regions.num_layers(); ++k) {
-    std::vector<int> members;
-    std::vector<ScoredBox> boxes;
-    for (std::size_t i = 0; i < proposals.boxes.size(); ++i)
-      if (proposals.layer[i] == k) {
-        members.push_back(static_cast<int>(i));
-        boxes.push_back(proposals.boxes[i]);
-      }
-    if (members.empty()) continue;
+  // Each region's share of the time left is its share of the grid windows left (near to far).
+  std::vector<double> windows(used, 0.0);
+  for (int k = 0; k < used; ++k) {
     const Box region = Intersect(regions.layers[k], oaocc.r1);
-    const BoxFeatureExtractor extractor(frame_colour, RegionEdgeMap(oaocc, regions, k),
-                                        cv::Point(region.x, region.y), image.size());
-    // Each region's features go straight to their rows of the merged matrix (no per-row
-    // cv::Mat copy).
-    extractor.ComputeInto(boxes, members, rows);
+    if (region.empty()) continue;
+    windows[k] = static_cast<double>(
+        CountWindows(region.w, region.h,
+                     RegionBoxParams(box_params, k, regions.num_layers(), options.multistride)));
   }
-  return rows;
+  double windows_left = 0;
+  for (const double w : windows) windows_left += w;
+  std::vector<std::vector<ScoredBox>> per_region;
+  std::vector<int> truncated;
+  for (int k = 0; k < used; ++k) {
+    EdgeBoxParams params = box_params;
+    params.threads = options.threads;
+    params.deadline = ShareOfRemaining(options.deadline, windows[k], windows_left);
+    windows_left -= windows[k];
+    EdgeBoxStats stats;
+    per_region.push_back(ProposeRegionBoxes(oaocc, regions, params, k, options.multistride,
+                                            options.size_filter ? &size_filter : nullptr, &stats));
+    if (stats.truncated) truncated.push_back(k);
+  }
+  ProposalSet out = MergeRegionBoxes(per_region, options.merge_iou);
+  out.truncated_regions = std::move(truncated);
+  return out;
 }
 
 }  // namespace tod

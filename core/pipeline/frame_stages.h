@@ -2,6 +2,7 @@
 // edges on R1 (§2-3), multistride proposals over the K regions (§4), the 20 features (§5).
 #pragma once
 
+#include <chrono>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "core/edges/sticky_superpixels.h"
 #include "core/pipeline/multilayer_regions.h"
 #include "core/pipeline/pipeline_params.h"
+#include "core/pipeline/proposal_features.h"
 #include "core/proposals/edge_box_scorer.h"
 #include "core/proposals/size_filter.h"
 #include "core/proposals/window_admission.h"
@@ -42,6 +44,10 @@ struct ProposalOptions {
   bool multistride = true;
   bool size_filter = true;
   float merge_iou = 0.75f;  // PipelineParams::region_merge_iou
+  // Frame budget (frame_budget.h): the regions are scanned near to far, each until its share of
+  // the time left to this deadline, by grid windows. No deadline: every window is scanned.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  int threads = 1;  // threads of each region's window scan (EdgeBoxParams::threads)
 };
 
 // The detector's proposal options for a bundle's parameters: all `layers`, its multistride, size
@@ -51,7 +57,14 @@ ProposalOptions DetectorProposalOptions(const PipelineParams& params, int layers
 struct ProposalSet {
   std::vector<ScoredBox> boxes;  // full-image coordinates, objectness descending
   std::vector<int> layer;        // 0-based region that produced each box
+  // Regions (0-based) whose window scan the deadline cut short.
+  std::vector<int> truncated_regions;
 };
+
+// Region k's (0-based) window-scan parameters: box_params with the multistride factor
+// (K - k + 1) / K of §4.2.6 (paper index k + 1), or 1 without multistride.
+EdgeBoxParams RegionBoxParams(const EdgeBoxParams& box_params, int k, int num_layers,
+                              bool multistride);
 
 // Boxes of region k (0-based) in full-image coordinates, objectness descending, through the size
 // filter when one is given. `stats` (may be null) receives the scorer's counters for the region
@@ -69,9 +82,5 @@ ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_regi
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                          const EdgeBoxParams& box_params, const ProposalOptions& options,
                          const SizeFilter& size_filter);
-
-// One row of 20 features per proposal, each computed on the region that produced it.
-cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
-                                  const MultilayerRegions& regions, const ProposalSet& proposals);
 
 }  // namespace tod

@@ -4,27 +4,9 @@
 #include <filesystem>
 #include <numeric>
 
-namespace tod {
+#include "core/pipeline/frame_budget.h"
 
-RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& image,
-                                    const OcclusionEdges& oaocc, const MultilayerRegions& regions,
-                                    ProposalSet proposals, StageTimer* timer) {
-  RegressedProposals out;
-  const cv::Mat1f features = ComputeProposalFeatures(image, oaocc, regions, proposals);
-  if (timer) timer->Mark("features");
-  if (timer && !timer->stopped().ok()) return out;  // cancelled: the caller returns the Status
-  out.ordr = bundle.ordr.PredictBatch(features);
-  // OBDR only matters for the boxes that pass the fusion gate (top keep_ratio by ORDR, §6.5), so
-  // only those are scored; the rest keep OBDR 0.
-  const std::vector<int> gated = GatedByOrdr(out.ordr, bundle.params.fusion);
-  const std::vector<float> gated_obdr = bundle.obdr.PredictBatch(features, gated);
-  out.obdr.assign(out.ordr.size(), 0.f);
-  for (std::size_t r = 0; r < gated.size() && r < gated_obdr.size(); ++r)
-    out.obdr[gated[r]] = gated_obdr[r];
-  if (timer) timer->Mark("regression");
-  out.proposals = std::move(proposals);
-  return out;
-}
+namespace tod {
 
 std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
                                              const std::vector<ScoredBox>& fused_boxes,
@@ -79,20 +61,28 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
     return Status::InvalidArgument("image too small: " + std::to_string(bgr.cols) + "x" +
                                    std::to_string(bgr.rows) + " (at least 16x16)");
   StageTimer timer(options.cancelled);  // asks options.cancelled at every stage boundary
+  const FrameBudget budget(std::chrono::steady_clock::now(), options.budget_ms);
+  const int threads = std::max(1, options.threads);
   const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
   const OcclusionEdges oaocc = ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges,
                                                      &bundle_.occlusion, bundle_.params,
                                                      /*enhance=*/true, &timer);
   if (!timer.stopped().ok()) return timer.stopped();
-  const ProposalOptions proposal_options =
+  ProposalOptions proposal_options =
       DetectorProposalOptions(bundle_.params, geometry.regions.num_layers());
+  proposal_options.deadline = budget.proposals_deadline();
+  proposal_options.threads = threads;
   ProposalSet proposals = ProposeBoxes(oaocc, geometry.regions, bundle_.params.boxes,
                                        proposal_options, geometry.size_filter);
   timer.Mark("proposals");
   if (!timer.stopped().ok()) return timer.stopped();
+  Detection out;
+  if (!proposals.truncated_regions.empty()) out.degraded_stages.push_back("proposals");
   RegressedProposals regressed =
-      RegressProposals(bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer);
+      RegressProposals(bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer,
+                       {.deadline = budget.regression_deadline(), .threads = threads});
   if (!timer.stopped().ok()) return timer.stopped();
+  if (regressed.truncated) out.degraded_stages.push_back("regression");
   const std::vector<float> fused =
       FuseScores(regressed.ordr, regressed.obdr, bundle_.params.fusion);
 
@@ -101,7 +91,6 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
     scored[i] = {regressed.proposals.boxes[i].box, fused[i]};
   const cv::Mat1f probability =
       AccumulateProbabilityMap(scored, bgr.size(), bundle_.params.probability_map);
-  Detection out;
   out.width = bgr.cols;
   out.height = bgr.rows;
   out.obstacles = ScoreObstacles(probability, scored, bundle_.params, options);

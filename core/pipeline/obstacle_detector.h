@@ -7,18 +7,9 @@
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/model_bundle.h"
+#include "core/pipeline/proposal_regression.h"
 
 namespace tod {
-
-// ORDR and OBDR scores of every proposal (features computed here).
-struct RegressedProposals {
-  ProposalSet proposals;
-  std::vector<float> ordr;
-  std::vector<float> obdr;
-};
-RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& image,
-                                    const OcclusionEdges& oaocc, const MultilayerRegions& regions,
-                                    ProposalSet proposals, StageTimer* timer = nullptr);
 
 // The obstacles of a frame: components of P > obstacle_threshold, each with its evidence and
 // calibrated score, those scoring below min_obstacle_score left out.

@@ -4,6 +4,7 @@
 // change, §4.2.6), refinement and NMS. Our own implementation.
 #pragma once
 
+#include <chrono>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -41,6 +42,13 @@ struct EdgeBoxParams {
   // Worker threads for the window grid: 1 = the calling thread only, 0 = all hardware threads.
   // The output is identical for every value (deterministic merge, §4.2.8 NMS on a total order).
   int threads = 1;
+  // Frame budget (issue 11): past this point the scan stops handing out grid columns and
+  // refinements; windows of the columns not scanned are not proposed, windows not refined keep
+  // their grid box, and EdgeBoxStats::truncated says so. Column chunks are handed out in a
+  // scattered order when a deadline is set, so what a cut-short scan leaves out is spread over
+  // every window shape and position (a coarser grid) instead of being its last shapes. The
+  // default, no deadline, scans everything in grid order.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };
 
 // Checks every field (ranges named in the message); ScoreEdgeBoxes returns no boxes for
@@ -61,6 +69,10 @@ struct EdgeBoxStats {
   // again without it (window_scan.h); the counters above describe the scan that gave the result,
   // except scorings, which counts both.
   long long rescans = 0;
+  // The deadline cut the scan short: column chunks never scanned and refinements skipped.
+  bool truncated = false;
+  long long columns_skipped = 0;
+  long long refinements_skipped = 0;
 };
 
 // edge_map: the region's occlusion-edge map normalised to max 1 (call NormaliseToMax first).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <exception>
 #include <numeric>
 #include <thread>
@@ -31,19 +32,45 @@ constexpr size_t kRefinementsPerChunk = 64;
 
 Box ToBox(const ScoreWindow& w) { return Box{w.c0, w.r0, w.c1 - w.c0 + 1, w.r1 - w.r0 + 1}; }
 
+using Clock = std::chrono::steady_clock;
+
+// A step through 0 .. n - 1 that visits every index once and spreads consecutive visits far
+// apart (a step near n / phi, coprime with n): the hand-out order when a deadline may cut a pass
+// short, so that the chunks left out are scattered over the pass instead of being its tail.
+size_t ScatteredStep(size_t n) {
+  if (n <= 2) return 1;
+  size_t step = std::max<size_t>(1, static_cast<size_t>(static_cast<double>(n) * 0.6180339887));
+  while (std::gcd(step, n) != 1) ++step;
+  return step % n == 0 ? 1 : step;
+}
+
+struct ChunkRun {
+  long long walks = 0;  // walks the scorer copies ran
+  size_t skipped = 0;   // chunks not run because the deadline had passed
+};
+
 // Runs body(scorer, chunk) for chunk = 0 .. chunks - 1 on `threads` threads (the caller's
-// included), each with its own copy of the scorer; returns the walks the copies ran. Which
-// thread runs which chunk varies, so bodies write only to their chunk's own output.
+// included), each with its own copy of the scorer. Which thread runs which chunk varies, so
+// bodies write only to their chunk's own output. With a deadline (not Clock::time_point::max()),
+// chunks are handed out in a scattered order and none is started once it has passed.
 template <typename Body>
-long long ParallelChunks(const BoxScorer& prototype, size_t chunks, int threads, Body body) {
-  std::atomic<size_t> next_chunk{0};
+ChunkRun ParallelChunks(const BoxScorer& prototype, size_t chunks, int threads,
+                        Clock::time_point deadline, Body body) {
+  const bool limited = deadline != Clock::time_point::max();
+  const size_t step = limited ? ScatteredStep(chunks) : 1;
+  std::atomic<size_t> next_turn{0};
+  std::atomic<size_t> done{0};
   std::atomic<long long> walks{0};
   std::atomic<bool> failed{false};
   std::exception_ptr failure;
   const auto work = [&]() {
     try {
       BoxScorer scorer(prototype);  // own walk scratch, shared map tables
-      for (size_t c = next_chunk++; c < chunks && !failed; c = next_chunk++) body(scorer, c);
+      for (size_t turn = next_turn++; turn < chunks && !failed; turn = next_turn++) {
+        if (limited && Clock::now() > deadline) break;
+        body(scorer, (turn * step) % chunks);
+        ++done;
+      }
       walks += scorer.past_early_exit() - prototype.past_early_exit();
     } catch (...) {
       if (!failed.exchange(true)) failure = std::current_exception();
@@ -57,7 +84,7 @@ long long ParallelChunks(const BoxScorer& prototype, size_t chunks, int threads,
     work();
   }  // joins the helpers
   if (failure) std::rethrow_exception(failure);
-  return walks.load();
+  return ChunkRun{walks.load(), chunks - done.load()};
 }
 
 struct ColumnChunk {
@@ -157,25 +184,40 @@ std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams&
   // Pass 1: score every grid window (steps 4-6).
   const size_t column_chunks = (columns.size() + kColumnsPerChunk - 1) / kColumnsPerChunk;
   std::vector<ColumnChunk> scanned(column_chunks);
-  stats.scorings += ParallelChunks(scorer, column_chunks, threads, [&](BoxScorer& s, size_t c) {
-    ColumnChunk& out = scanned[c];
-    const size_t end = std::min(columns.size(), (c + 1) * kColumnsPerChunk);
-    const long long walks_before = s.past_early_exit();
-    for (size_t i = c * kColumnsPerChunk; i < end; ++i) {
-      const WindowShape& shape = shapes[columns[i].shape];
-      // Tops admitted for this column: the shape's own unless the column is clamped narrower.
-      const RowRanges* tops = admission != nullptr ? &shape_tops[columns[i].shape] : nullptr;
-      RowRanges clamped_tops;
-      if (tops != nullptr && columns[i].x + shape.width > s.width() - 1) {
-        clamped_tops = admitted_tops_of(columns[i].x, shape);
-        tops = &clamped_tops;
+  const ChunkRun scan =
+      ParallelChunks(scorer, column_chunks, threads, params.deadline, [&](BoxScorer& s, size_t c) {
+        ColumnChunk& out = scanned[c];
+        const size_t end = std::min(columns.size(), (c + 1) * kColumnsPerChunk);
+        const long long walks_before = s.past_early_exit();
+        for (size_t i = c * kColumnsPerChunk; i < end; ++i) {
+          const WindowShape& shape = shapes[columns[i].shape];
+          // Tops admitted for this column: the shape's own unless the column is clamped narrower.
+          const RowRanges* tops = admission != nullptr ? &shape_tops[columns[i].shape] : nullptr;
+          RowRanges clamped_tops;
+          if (tops != nullptr && columns[i].x + shape.width > s.width() - 1) {
+            clamped_tops = admitted_tops_of(columns[i].x, shape);
+            tops = &clamped_tops;
+          }
+          out.windows += s.ScoreColumn(columns[i].x, shape.width, shape.height, shape.stride_y,
+                                       tops, bar, out.hits, &out.rows);
+          out.hit_end.push_back(static_cast<int>(out.hits.size()));
+        }
+        out.walks = s.past_early_exit() - walks_before;
+      });
+  stats.scorings += scan.walks;
+  if (scan.skipped > 0) {
+    stats.truncated = true;
+    // A chunk never scanned has no hit_end entries; give it one empty entry per column so that
+    // column_begin below still indexes `columns`.
+    for (size_t c = 0; c < column_chunks; ++c) {
+      const size_t in_chunk =
+          std::min(columns.size(), (c + 1) * kColumnsPerChunk) - c * kColumnsPerChunk;
+      if (scanned[c].hit_end.empty()) {
+        scanned[c].hit_end.assign(in_chunk, 0);
+        stats.columns_skipped += static_cast<long long>(in_chunk);
       }
-      out.windows += s.ScoreColumn(columns[i].x, shape.width, shape.height, shape.stride_y, tops,
-                                   bar, out.hits, &out.rows);
-      out.hit_end.push_back(static_cast<int>(out.hits.size()));
     }
-    out.walks = s.past_early_exit() - walks_before;
-  });
+  }
   std::vector<ScoreWindow> hits;
   std::vector<int> hit_rows;
   std::vector<size_t> column_begin{0};  // hits of column i: [column_begin[i], column_begin[i+1])
@@ -207,11 +249,19 @@ std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams&
     if (bar >= 0.f && chosen.size() < static_cast<size_t>(params.refine_limit)) *settled = false;
     chosen = BestByGridScore(hits, std::move(chosen), params.refine_limit);
     const size_t chunks = (chosen.size() + kRefinementsPerChunk - 1) / kRefinementsPerChunk;
-    stats.scorings += ParallelChunks(scorer, chunks, threads, [&](BoxScorer& s, size_t c) {
-      const size_t end = std::min(chosen.size(), (c + 1) * kRefinementsPerChunk);
-      for (size_t i = c * kRefinementsPerChunk; i < end; ++i) s.Refine(hits[chosen[i]]);
-    });
-    stats.windows_refined = static_cast<long long>(chosen.size());
+    std::atomic<long long> refined_windows{0};
+    const ChunkRun refined =
+        ParallelChunks(scorer, chunks, threads, params.deadline, [&](BoxScorer& s, size_t c) {
+          const size_t end = std::min(chosen.size(), (c + 1) * kRefinementsPerChunk);
+          for (size_t i = c * kRefinementsPerChunk; i < end; ++i) s.Refine(hits[chosen[i]]);
+          refined_windows += static_cast<long long>(end - c * kRefinementsPerChunk);
+        });
+    stats.scorings += refined.walks;
+    stats.windows_refined = refined_windows.load();
+    if (refined.skipped > 0) {
+      stats.truncated = true;
+      stats.refinements_skipped = static_cast<long long>(chosen.size()) - stats.windows_refined;
+    }
   }
   std::vector<ScoredBox> boxes;
   boxes.reserve(hits.size());
@@ -246,7 +296,8 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
     bool settled = true;
     std::vector<ScoredBox> kept =
         ScanWithBar(scorer, params, stats, admission, provisional_bar * params.min_score, &settled);
-    if (settled) return kept;
+    // A scan the deadline cut short is the result: there is no time for a second one.
+    if (settled || stats.truncated) return kept;
     const long long provisional_scorings = stats.scorings - before.scorings;
     stats = before;
     stats.rescans += 1;

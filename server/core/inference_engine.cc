@@ -42,6 +42,13 @@ std::optional<CancelReason> StopReason(
   return cancellation.reason();
 }
 
+// The server's budget, lowered by the request's when it sets one (0 = unset; <= 0: no budget).
+double EffectiveBudgetMs(double server_ms, double request_ms) {
+  if (request_ms <= 0) return server_ms;
+  if (server_ms <= 0) return request_ms;
+  return std::min(server_ms, request_ms);
+}
+
 }  // namespace
 
 const char* RejectionName(Rejection rejection) {
@@ -93,6 +100,12 @@ Status InferenceEngine::ValidateOptions(const DetectOptions& options) const {
   if (!(options.min_obstacle_score >= 0.f && options.min_obstacle_score <= 1.f)) {
     return Status::InvalidArgument(
         "min_obstacle_score: " + std::to_string(options.min_obstacle_score) + " is outside [0, 1]");
+  }
+  // 0 = not set; otherwise a whole number of ms in range (also refuses NaN).
+  if (options.budget_ms != 0 &&
+      !(options.budget_ms >= 1 && options.budget_ms <= static_cast<double>(kMaxRequestBudgetMs))) {
+    return Status::InvalidArgument("budget_ms: " + std::to_string(options.budget_ms) +
+                                   " is outside [1, " + std::to_string(kMaxRequestBudgetMs) + "]");
   }
   return Status::Ok();
 }
@@ -172,9 +185,10 @@ void InferenceEngine::Submit(const InferenceRequest& request, Completion done) {
 }
 
 void InferenceEngine::WorkerLoop() {
-  // Parallelism comes from the worker pool; OpenCV's own thread pool inside each worker would
-  // only oversubscribe the cores.
-  cv::setNumThreads(1);
+  // Parallelism comes from the worker pool and --threads-per-request; OpenCV's pool (process-wide,
+  // used by the edge classifier's row loop) gets the same per-request width, so that workers x
+  // threads_per_request stays the number of busy cores.
+  cv::setNumThreads(config_.threads_per_request);
   for (;;) {
     Job job;
     bool stop_now = false;
@@ -223,6 +237,7 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
     return Refusal(Status::Unavailable("no model loaded"), Rejection::kNotReady);
   }
 
+  const Clock::time_point started = Clock::now();  // the frame budget counts from here
   StageTimer timer;
   Result<cv::Mat3b> image = DecodeImage(request.image, config_.limits);
   if (!image.ok()) {
@@ -239,6 +254,12 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
 
   DetectOptions options = request.options;
   options.want_probability_map = request.encode_map_png;
+  options.threads = config_.threads_per_request;
+  options.budget_ms = EffectiveBudgetMs(config_.frame_budget_ms, request.options.budget_ms);
+  // Decoding already spent part of it (a budget this leaves at 0 or below still limits: the
+  // pipeline then degrades as much as it can).
+  if (options.budget_ms > 0)
+    options.budget_ms = std::max(1.0, options.budget_ms - MillisecondsSince(started));
   // Asked between the pipeline's stages; the Status it returns is only a signal here: the result
   // is rebuilt from the reason below so the message says where the work stopped.
   int boundaries = 0;  // stage boundaries passed, for the message
@@ -278,7 +299,11 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
     result.map_png = std::move(*png);
     result.timings.emplace_back("encode_map", MillisecondsSince(encode_start));
   }
-  if (metrics_ != nullptr) metrics_->ObserveStages(result.timings);
+  if (metrics_ != nullptr) {
+    metrics_->ObserveStages(result.timings);
+    for (const std::string& stage : result.detection.degraded_stages)
+      metrics_->RecordDegraded(stage);
+  }
   return result;
 }
 

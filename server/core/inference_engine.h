@@ -69,9 +69,16 @@ struct InferenceResult {
 
 using Completion = std::function<void(InferenceResult)>;
 
+// A request's budget_ms option, when set, must lie in [1, this].
+inline constexpr long long kMaxRequestBudgetMs = 600'000;
+
 struct EngineConfig {
   int workers = 1;
-  int queue_capacity = 16;  // requests waiting (not counting the ones running)
+  // Frame budget (core/pipeline/frame_budget.h), counted from when a worker takes the request
+  // (decode included); a request's budget_ms may lower it. <= 0: none.
+  double frame_budget_ms = 2000;
+  int threads_per_request = 1;  // cores one request may use (DetectOptions::threads)
+  int queue_capacity = 16;      // requests waiting (not counting the ones running)
   ImageLimits limits;
   int max_proposals_cap = 10000;  // options above this are refused
 };

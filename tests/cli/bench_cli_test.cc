@@ -108,6 +108,36 @@ TEST_F(BenchCliTest, LimitTakesTheFirstFramesByPath) {
   EXPECT_EQ(fs::path(j["per_frame"][0]["frame"].get<std::string>()).filename(), "a.png");
 }
 
+// --frame-budget-ms and --threads-per-request, as tod_server has them: a budget no frame can
+// meet degrades every frame's proposals, and bench and detect both say so.
+TEST_F(BenchCliTest, FrameBudgetDegradationIsReportedByBenchAndDetect) {
+  const fs::path json_path = out_ / "budget.json";
+  const CommandResult run =
+      Bench("--frame-budget-ms 1 --threads-per-request 2 --json " + json_path.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("frame budget 1 ms (2 frames degraded)"), std::string::npos)
+      << run.output;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["frame_budget_ms"], 1);
+  EXPECT_EQ(j["degraded_frames"], 2);
+  for (const nlohmann::json& frame : j["per_frame"])
+    EXPECT_EQ(frame["degraded_stages"][0], "proposals") << frame.dump();
+
+  const fs::path detect_out = out_ / "detect";
+  const CommandResult detect =
+      RunCommand(tod_ + " detect --model " + model_ + " --out " + detect_out.string() +
+                 " --frame-budget-ms 1 " + (frames_ / "a.png").string());
+  ASSERT_EQ(detect.exit_code, 0) << detect.output;
+  std::ifstream detect_json(detect_out / "a.json");
+  const nlohmann::json d = nlohmann::json::parse(detect_json);
+  EXPECT_EQ(d["degraded"], true) << d.dump();
+  EXPECT_EQ(d["degraded_stages"][0], "proposals");
+
+  const CommandResult refused = Bench("--frame-budget-ms -5");
+  EXPECT_NE(refused.exit_code, 0) << refused.output;
+}
+
 TEST_F(BenchCliTest, ADirectoryWithoutFramesIsAnError) {
   const fs::path empty = out_ / "empty";
   fs::create_directories(empty);

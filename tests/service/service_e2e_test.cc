@@ -229,6 +229,42 @@ TEST_F(ServiceE2ETest, ModelInfoHealthAndMetrics) {
   EXPECT_NE(metrics.find(R"(generation="1")"), std::string::npos);
 }
 
+// The frame budget: a request may lower the server's --frame-budget-ms; a budget the frame
+// cannot meet degrades its proposals, the answer is still 200 / OK and says so, and the metric
+// counts it. (1 ms is spent before the window scan starts on any machine.)
+TEST_F(ServiceE2ETest, AFrameOverItsBudgetDegradesSaysSoAndIsCounted) {
+  const std::string frame = testing::RoadPng();
+  const auto rest = PostImage(*http_, "/v1/detect?map=none&budget_ms=1", frame);
+  ASSERT_TRUE(rest);
+  ASSERT_EQ(rest->status, 200) << rest->body;
+  const nlohmann::json json = nlohmann::json::parse(rest->body);
+  EXPECT_EQ(json["degraded"], true) << rest->body;
+  ASSERT_TRUE(json["degraded_stages"].is_array());
+  EXPECT_EQ(json["degraded_stages"][0], "proposals");
+
+  tod::v1::DetectRequest request = MakeRequest(frame);
+  request.mutable_options()->set_budget_ms(1);
+  tod::v1::DetectResponse response;
+  ASSERT_TRUE(grpc_->Detect(request, &response).ok());
+  EXPECT_TRUE(response.degraded());
+  ASSERT_GE(response.degraded_stages_size(), 1);
+  EXPECT_EQ(response.degraded_stages(0), "proposals");
+
+  const std::string metrics = ScrapeMetrics(server_->http_port());
+  EXPECT_GE(MetricValue(metrics, R"(tod_frames_degraded_total{stage="proposals"})").value_or(0), 2)
+      << metrics;
+
+  // Out of range: refused before any work, naming the option.
+  for (const std::string query : {"budget_ms=0", "budget_ms=600001", "budget_ms=-3"}) {
+    const auto refused = PostImage(*http_, "/v1/detect?" + query, frame);
+    ASSERT_TRUE(refused);
+    EXPECT_EQ(refused->status, 400) << query;
+    EXPECT_NE(ErrorMessage(refused).find("budget_ms"), std::string::npos) << refused->body;
+  }
+  request.mutable_options()->set_budget_ms(700'000);
+  EXPECT_EQ(grpc_->Detect(request, &response).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+}
+
 TEST_F(ServiceE2ETest, RestErrorsHaveCodesAndMessages) {
   struct Case {
     std::string path;

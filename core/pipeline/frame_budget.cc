@@ -1,0 +1,34 @@
+#include "core/pipeline/frame_budget.h"
+
+#include <algorithm>
+
+namespace tod {
+
+namespace {
+
+FrameBudget::Clock::time_point At(FrameBudget::Clock::time_point start, double ms) {
+  return start + std::chrono::duration_cast<FrameBudget::Clock::duration>(
+                     std::chrono::duration<double, std::milli>(ms));
+}
+
+}  // namespace
+
+FrameBudget::FrameBudget(Clock::time_point start, double budget_ms,
+                         const FrameBudgetParams& params) {
+  if (!(budget_ms > 0)) return;
+  limited_ = true;
+  proposals_deadline_ = At(start, budget_ms * std::clamp(params.proposals_end, 0.0, 1.0));
+  regression_deadline_ = At(start, budget_ms * std::clamp(params.regression_end, 0.0, 1.0));
+}
+
+std::chrono::steady_clock::time_point ShareOfRemaining(
+    std::chrono::steady_clock::time_point stage_deadline, double weight, double remaining_weight) {
+  using Clock = std::chrono::steady_clock;
+  if (stage_deadline == Clock::time_point::max()) return stage_deadline;
+  const Clock::time_point now = Clock::now();
+  if (now >= stage_deadline || !(remaining_weight > 0)) return stage_deadline;
+  const double share = std::clamp(weight / remaining_weight, 0.0, 1.0);
+  return now + std::chrono::duration_cast<Clock::duration>((stage_deadline - now) * share);
+}
+
+}  // namespace tod

@@ -1,0 +1,49 @@
+// The time one frame may take (issue 11, `--frame-budget-ms`), and how the stages share it.
+// Edges, superpixels and the occlusion map cost what the frame's pixels cost (bounded by the
+// pixel limit) and always run whole; the two stages whose cost grows with the frame's content
+// degrade when their share runs out, in a defined way:
+//  - proposals: the window scan of each region stops handing out grid columns at the region's
+//    deadline (the columns left out are scattered over shapes and positions: a coarser grid);
+//    the far regions, scanned last, lose windows first;
+//  - features and regression: proposals are regressed in objectness order, in chunks; those not
+//    reached by the deadline are left out of the map.
+// A frame that degrades says so (Detection::degraded_stages) and the server counts it.
+#pragma once
+
+#include <chrono>
+
+namespace tod {
+
+struct FrameBudgetParams {
+  // The points, as fractions of the budget from the frame's start, by which the proposals and
+  // the features + ORDR must be done. The rest is left for OBDR on the gated boxes, the map and
+  // its encoding (a few tens of ms on 2 MP frames).
+  double proposals_end = 0.55;
+  double regression_end = 0.85;
+};
+
+class FrameBudget {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // No budget: every deadline is Clock::time_point::max().
+  FrameBudget() = default;
+  // budget_ms <= 0 means no budget.
+  FrameBudget(Clock::time_point start, double budget_ms, const FrameBudgetParams& params = {});
+
+  bool limited() const { return limited_; }
+  Clock::time_point proposals_deadline() const { return proposals_deadline_; }
+  Clock::time_point regression_deadline() const { return regression_deadline_; }
+
+ private:
+  bool limited_ = false;
+  Clock::time_point proposals_deadline_ = Clock::time_point::max();
+  Clock::time_point regression_deadline_ = Clock::time_point::max();
+};
+
+// Deadlines for consecutive pieces of work sharing [now, stage_deadline): piece i gets
+// now + (stage_deadline - now) * weight_i / (weight_i + ... + weight_last), asked again when
+// piece i starts, so time a piece leaves unused passes on to the next ones.
+std::chrono::steady_clock::time_point ShareOfRemaining(
+    std::chrono::steady_clock::time_point stage_deadline, double weight, double remaining_weight);
+
+}  // namespace tod

@@ -1,0 +1,51 @@
+#include "core/pipeline/proposal_features.h"
+
+#include "core/features/colour_integrals.h"
+#include "core/pipeline/frame_stages.h"
+
+namespace tod {
+
+ProposalFeatureComputer::ProposalFeatureComputer(const cv::Mat3b& image,
+                                                 const OcclusionEdges& oaocc,
+                                                 const MultilayerRegions& regions,
+                                                 const ProposalSet& proposals)
+    : proposals_(proposals), per_region_(regions.num_layers()) {
+  if (proposals.boxes.empty()) return;
+  std::vector<bool> used(regions.num_layers(), false);
+  for (const int k : proposals.layer) used[k] = true;
+  const auto frame_colour = std::make_shared<const ColourIntegrals>(
+      image(oaocc.r1.rect()), cv::Point(oaocc.r1.x, oaocc.r1.y));
+  for (int k = 0; k < regions.num_layers(); ++k) {
+    if (!used[k]) continue;
+    const Box region = Intersect(regions.layers[k], oaocc.r1);
+    per_region_[k] =
+        std::make_unique<const BoxFeatureExtractor>(frame_colour, RegionEdgeMap(oaocc, regions, k),
+                                                    cv::Point(region.x, region.y), image.size());
+  }
+}
+
+void ProposalFeatureComputer::ComputeRange(std::size_t begin, std::size_t end,
+                                           cv::Mat1f& out) const {
+  // Grouped by region, each region's rows go straight to their place in `out`.
+  for (std::size_t k = 0; k < per_region_.size(); ++k) {
+    if (!per_region_[k]) continue;
+    std::vector<int> rows;
+    std::vector<ScoredBox> boxes;
+    for (std::size_t i = begin; i < end && i < proposals_.boxes.size(); ++i)
+      if (proposals_.layer[i] == static_cast<int>(k)) {
+        rows.push_back(static_cast<int>(i));
+        boxes.push_back(proposals_.boxes[i]);
+      }
+    if (!rows.empty()) per_region_[k]->ComputeInto(boxes, rows, out);
+  }
+}
+
+cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
+                                  const MultilayerRegions& regions, const ProposalSet& proposals) {
+  cv::Mat1f rows(static_cast<int>(proposals.boxes.size()), kNumBoxFeatures, 0.f);
+  ProposalFeatureComputer(image, oaocc, regions, proposals)
+      .ComputeRange(0, proposals.boxes.size(), rows);
+  return rows;
+}
+
+}  // namespace tod

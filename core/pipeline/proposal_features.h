@@ -1,0 +1,39 @@
+// The 20 features of a frame's proposals (§5), each computed on the region that produced it.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "core/features/box_features.h"
+#include "core/pipeline/multilayer_regions.h"
+
+namespace tod {
+
+struct OcclusionEdges;
+struct ProposalSet;
+
+// Computes the feature rows of any range of a frame's proposals: the colour integrals of R1
+// (shared by every region, the regions being nested crops of R1) and each region's edge tables
+// are built once, so a frame's proposals can be measured in chunks (the frame budget regresses
+// them in objectness order until its deadline) or by several threads at once (ComputeRange is
+// const and thread-safe).
+class ProposalFeatureComputer {
+ public:
+  // Keeps references to all three arguments: they must outlive the computer.
+  ProposalFeatureComputer(const cv::Mat3b& image, const OcclusionEdges& oaocc,
+                          const MultilayerRegions& regions, const ProposalSet& proposals);
+  // Rows [begin, end) of `out` (proposals x kNumBoxFeatures) for proposals [begin, end).
+  void ComputeRange(std::size_t begin, std::size_t end, cv::Mat1f& out) const;
+
+ private:
+  const ProposalSet& proposals_;
+  std::vector<std::unique_ptr<const BoxFeatureExtractor>> per_region_;  // null: no proposal
+};
+
+// One row of 20 features per proposal.
+cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
+                                  const MultilayerRegions& regions, const ProposalSet& proposals);
+
+}  // namespace tod
