@@ -5,6 +5,8 @@
 //     measured from the scheduled time, so a slow server cannot hide queueing by slowing the
 //     sender down (no coordinated omission). --concurrency is then the number of senders.
 // Requests cycle through the images of --images; the first --warmup seconds are not measured.
+// --corrupt sends damaged versions of the images instead (truncated JPEG and PNG, noise), for
+// soak tests that mix bad requests into the load (deploy/soak.sh).
 #include <httplib.h>
 
 #include <CLI/CLI.hpp>
@@ -17,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "client/corrupt_bodies.h"
 #include "client/detect_outputs.h"
 #include "client/image_files.h"
 #include "client/load_stats.h"
@@ -25,11 +28,15 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// --corrupt: damaged versions of this many frames are enough variety (each takes a decode and two
+// encodes at start-up).
+constexpr size_t kCorruptFrames = 8;
 
 struct LoadArgs {
   std::string addr;
   std::string images_dir;
   bool http = false;
+  bool corrupt = false;
   int concurrency = 4;
   double rate = 0;  // > 0: open loop
   double duration_s = 10;
@@ -136,6 +143,9 @@ int main(int argc, char** argv) {
   app.add_option("--images", args.images_dir, "Folder of .png/.jpg frames to cycle through")
       ->required();
   app.add_flag("--http", args.http, "Use REST POST /v1/detect instead of gRPC");
+  app.add_flag("--corrupt", args.corrupt,
+               "Send damaged images instead (each of the first 8: its JPEG and PNG cut in half, "
+               "noise of its size); the server must answer each with 400 / INVALID_ARGUMENT");
   auto* concurrency = app.add_option("--concurrency", args.concurrency,
                                      "Closed loop: requests in flight; open loop: senders")
                           ->check(CLI::Range(1, 4096));
@@ -172,13 +182,22 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::vector<Image> images;
+  size_t corrupted_frames = 0;
   for (const std::string& path : *paths) {
+    if (args.corrupt && corrupted_frames == kCorruptFrames) break;
     auto bytes = tod::client::ReadFileBytes(path);
     if (!bytes.ok()) {
       std::cerr << "tod_load: " << bytes.status().message() << "\n";
       return 2;
     }
-    images.push_back({path, std::move(*bytes), tod::client::ContentTypeFor(path)});
+    if (!args.corrupt) {
+      images.push_back({path, std::move(*bytes), tod::client::ContentTypeFor(path)});
+    } else {
+      for (tod::client::RequestBody& body :
+           tod::client::CorruptBodies(*bytes, static_cast<uint32_t>(corrupted_frames++))) {
+        images.push_back({path + " (" + body.name + ")", std::move(body.bytes), body.content_type});
+      }
+    }
   }
 
   tod::client::TodGrpcClient grpc_client(args.addr, args.connection);

@@ -503,5 +503,89 @@ TEST(HttpHardeningOwnServerTest, SilentConnectionsAreClosedAtTheIdleTimeout) {
   EXPECT_GE(Refused(server->http_port(), "idle_timeout"), 1);
 }
 
+// A client that sends valid requests but does not read the answers (or reads one byte a second)
+// leaves each answer in the server's socket. Writing one answer has a deadline of its own
+// (--http-write-timeout): when it passes, the connection is closed and its slot, in-flight count
+// and body budget are free again; probes are answered all the while. Asserted through metrics
+// polled with generous bounds, never through how long anything took.
+void ExpectSlowReaderIsCutAtTheWriteDeadline(bool reads_a_byte_a_second) {
+  REQUIRE_MODEL();
+  // 10 s: long enough that probes are surely seen while the answer is held, even on a busy machine.
+  auto server = StartServer({"--http-write-timeout", "10"});
+  ASSERT_TRUE(server->WaitReady()) << server->Log();
+  const int port = server->http_port();
+  // A small receive window, so that unread answers back up into the server after a few of them.
+  RawConnection reader(port, /*receive_buffer_bytes=*/4096);
+  ASSERT_TRUE(reader.connected());
+  const std::string png = testing::RoadPng();
+  ASSERT_TRUE(
+      reader.Send("POST /v1/detect?map=none HTTP/1.1\r\nHost: t\r\nContent-Type: "
+                  "image/png\r\nContent-Length: " +
+                  std::to_string(png.size()) + "\r\n\r\n" + png));
+  // Then valid requests pipelined behind it, as long as the server reads them: it stops reading
+  // when an answer no longer fits into the socket, which is the write the deadline must bound.
+  const std::string scrape = "GET /metrics HTTP/1.1\r\nHost: t\r\n\r\n";
+  httplib::Client probe("127.0.0.1", port);
+  probe.set_connection_timeout(10s);
+  probe.set_read_timeout(10s);
+  std::string read_slowly;
+  int probes_answered = 0;
+  int probes_while_held = 0;  // answered while the reader's connection was full and not yet cut
+  bool cut = false;
+  uint64_t pipelined = 0;
+  const auto give_up = std::chrono::steady_clock::now() + 120s;
+  while (!cut && std::chrono::steady_clock::now() < give_up) {
+    const std::optional<uint64_t> sent = reader.SendRepeatedWhileRoom(scrape, 64 * kMiB);
+    if (!sent) break;  // the server closed the connection
+    pipelined += *sent;
+    if (reads_a_byte_a_second) {
+      bool closed = false;
+      if (const std::optional<char> byte = reader.ReadByte(0ms, &closed)) read_slowly += *byte;
+      if (closed) break;
+    }
+    const auto live = probe.Get("/v2/health/live");
+    ASSERT_TRUE(live && live->status == 200) << "liveness probe not answered";
+    ++probes_answered;
+    cut = Refused(port, "write_timeout") >= 1;
+    if (!cut && *sent == 0) ++probes_while_held;
+    std::this_thread::sleep_for(1s);
+  }
+  EXPECT_TRUE(server->WaitForMetric(R"(tod_http_refused_total{reason="write_timeout"})", 1, 60s))
+      << "no write timeout after " << pipelined << " pipelined bytes";
+  EXPECT_GE(probes_while_held, 1) << "no probe answered while the answers were held";
+  EXPECT_TRUE(reader.WaitClosed(60s)) << "the server kept the connection";
+  // What trickled through is the start of the detection's answer.
+  const std::string status_line = "HTTP/1.1 200 OK";
+  EXPECT_EQ(read_slowly.substr(0, status_line.size()),
+            status_line.substr(0, std::min(read_slowly.size(), status_line.size())));
+  // Nothing held: no request in flight, only the scraper's own connection open (closed
+  // connections are noticed asynchronously: polled, bounded).
+  std::string metrics;
+  for (int attempt = 0; attempt < 300; ++attempt) {
+    metrics = ScrapeMetrics(port);
+    if (MetricValue(metrics, "tod_http_open_connections").value_or(-1) <= 1 &&
+        MetricValue(metrics, "tod_in_flight_requests").value_or(-1) == 0) {
+      break;
+    }
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_LE(MetricValue(metrics, "tod_http_open_connections").value_or(-1), 1) << metrics;
+  EXPECT_EQ(MetricValue(metrics, "tod_in_flight_requests").value_or(-1), 0) << metrics;
+  EXPECT_NE(server->Log().find("write_timeout"), std::string::npos);
+  // And the server serves as before.
+  probe.set_read_timeout(60s);
+  const auto detect = probe.Post("/v1/detect?map=none", png, "image/png");
+  ASSERT_TRUE(detect);
+  EXPECT_EQ(detect->status, 200) << detect->body;
+}
+
+TEST(HttpHardeningOwnServerTest, ClientNotReadingItsAnswersIsCutAtTheWriteDeadline) {
+  ExpectSlowReaderIsCutAtTheWriteDeadline(/*reads_a_byte_a_second=*/false);
+}
+
+TEST(HttpHardeningOwnServerTest, ClientReadingOneByteASecondIsCutAtTheWriteDeadline) {
+  ExpectSlowReaderIsCutAtTheWriteDeadline(/*reads_a_byte_a_second=*/true);
+}
+
 }  // namespace
 }  // namespace tod::server

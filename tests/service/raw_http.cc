@@ -52,9 +52,18 @@ std::optional<RawResponse> ParseHead(const std::string& head) {
 
 }  // namespace
 
-RawConnection::RawConnection(int port) {
+RawConnection::RawConnection(int port) { Connect(port, 0); }
+
+RawConnection::RawConnection(int port, int receive_buffer_bytes) {
+  Connect(port, receive_buffer_bytes);
+}
+
+void RawConnection::Connect(int port, int receive_buffer_bytes) {
   fd_ = socket(AF_INET, SOCK_STREAM, 0);
   if (fd_ < 0) return;
+  if (receive_buffer_bytes > 0) {
+    setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &receive_buffer_bytes, sizeof(receive_buffer_bytes));
+  }
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
@@ -149,6 +158,44 @@ RawConnection::Streamed RawConnection::StreamUntilAnswered(std::string_view head
   fcntl(fd_, F_SETFL, flags);
   result.response = ReadResponse(std::chrono::milliseconds(std::max(1000, RemainingMs(deadline))));
   return result;
+}
+
+std::optional<uint64_t> RawConnection::SendRepeatedWhileRoom(std::string_view piece,
+                                                             uint64_t limit) {
+  uint64_t sent = 0;
+  while (sent < limit) {
+    const std::string_view rest = piece.substr(piece_sent_);
+    const size_t want = static_cast<size_t>(std::min<uint64_t>(rest.size(), limit - sent));
+    const ssize_t n = send(fd_, rest.data(), want, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;  // full: nobody reads it
+    if (n <= 0) return std::nullopt;
+    sent += static_cast<uint64_t>(n);
+    piece_sent_ = (piece_sent_ + static_cast<size_t>(n)) % piece.size();
+  }
+  return sent;
+}
+
+std::optional<char> RawConnection::ReadByte(std::chrono::milliseconds wait, bool* closed) {
+  *closed = false;
+  if (!Readable(wait)) return std::nullopt;
+  char byte = 0;
+  const ssize_t n = recv(fd_, &byte, 1, 0);
+  if (n == 1) return byte;
+  *closed = !(n < 0 && (errno == EINTR || errno == EAGAIN));
+  return std::nullopt;
+}
+
+bool RawConnection::WaitClosed(std::chrono::milliseconds timeout) {
+  const Clock::time_point deadline = Clock::now() + timeout;
+  char buffer[65536];
+  for (;;) {
+    pollfd fd{fd_, POLLIN, 0};
+    if (poll(&fd, 1, RemainingMs(deadline)) <= 0) return false;  // timed out, still open
+    const ssize_t n = recv(fd_, buffer, sizeof(buffer), 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return true;  // EOF or reset
+  }
 }
 
 MemoryKb ProcessMemory(int pid) {

@@ -1,5 +1,6 @@
 // A plain TCP client on 127.0.0.1 for the HTTP hardening tests: it sends exactly the bytes a
-// test gives (malformed, endless, trickling) and reads back one HTTP/1.1 response.
+// test gives (malformed, endless, trickling), reads back one HTTP/1.1 response, or reads nothing
+// (or one byte at a time) to play a client that does not take its answers.
 #pragma once
 
 #include <chrono>
@@ -20,6 +21,9 @@ struct RawResponse {
 class RawConnection {
  public:
   explicit RawConnection(int port);  // connects to 127.0.0.1:port (see connected())
+  // Also caps the socket's receive buffer (before connecting, so that the window the server sees
+  // stays that small): answers the test does not read then back up into the server quickly.
+  RawConnection(int port, int receive_buffer_bytes);
   ~RawConnection();
   RawConnection(const RawConnection&) = delete;
   RawConnection& operator=(const RawConnection&) = delete;
@@ -42,9 +46,23 @@ class RawConnection {
   Streamed StreamUntilAnswered(std::string_view head, std::string_view piece, uint64_t limit,
                                std::chrono::milliseconds timeout);
 
+  // Without blocking: sends `piece` again and again (pipelined requests) for as long as the socket
+  // takes bytes, at most `limit` bytes this call; a piece cut short is finished first next call.
+  // The bytes sent (0: the socket is full, the server is not reading), or nullopt when the
+  // connection broke.
+  std::optional<uint64_t> SendRepeatedWhileRoom(std::string_view piece, uint64_t limit);
+  // One byte if one arrives within `wait`; nullopt on timeout; EOF or an error: `closed` is set.
+  std::optional<char> ReadByte(std::chrono::milliseconds wait, bool* closed);
+  // Reads and discards until the server ends the connection (EOF or reset); false if it is still
+  // open after `timeout`.
+  bool WaitClosed(std::chrono::milliseconds timeout);
+
  private:
+  void Connect(int port, int receive_buffer_bytes);
+
   int fd_ = -1;
   std::string received_;
+  size_t piece_sent_ = 0;  // SendRepeatedWhileRoom: bytes of the current piece already sent
 };
 
 // Resident and peak resident memory of a process, kB (/proc/<pid>/status VmRSS, VmHWM).
