@@ -16,7 +16,7 @@ BUILD_PACKAGES=(
   libcpp-httplib-dev
   libgtest-dev libgmock-dev
   clang libclang-rt-14-dev
-  openssl stress-ng
+  openssl stress-ng curl
 )
 # libboost-dev: Boost.Beast/Asio (header-only) for tod_server's REST transport.
 # libjpeg62-turbo-dev, libpng-dev: tod_server's strict image decoders.
@@ -26,6 +26,8 @@ BUILD_PACKAGES=(
 # clang, libclang-rt-14-dev: the libFuzzer targets (tests/fuzz/; libFuzzer and the sanitizer
 # runtimes of Debian 12's clang 14). The production build stays on gcc.
 # openssl: the service tests make a throw-away CA and certificates with the openssl command.
+# curl: deploy/soak.sh (and its ctest soak_smoke) and deploy/bench_server.sh probe and scrape
+# the server with it.
 # stress-ng: loads the CPUs beside the service tests to check they hold on a busy machine.
 
 RUNTIME_PACKAGES=(
