@@ -1,6 +1,8 @@
 // tod detect --model MODEL_DIR IMAGE... --out DIR: per image STEM, STEM.json, STEM_prob.png
 // (probability map, 255 = 1.0) and STEM_overlay.png; with --stages also the pictures and counts
 // of the intermediate stages (core/pipeline/stage_images.h).
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
@@ -10,6 +12,7 @@
 #include "core/cli/commands.h"
 #include "core/cli/request_options.h"
 #include "core/pipeline/detection_output.h"
+#include "core/pipeline/frame_budget.h"
 #include "core/pipeline/model_bundle.h"
 #include "core/pipeline/stage_images.h"
 
@@ -55,13 +58,22 @@ Runner AddDetectCommand(CLI::App& app) {
     if (ec) return Fail("cannot create " + args->out + ": " + ec.message());
     int failures = 0;
     for (const std::string& path : args->images) {
+      const auto read_start = std::chrono::steady_clock::now();
       const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
       if (image.empty()) {
         std::cerr << "tod: " << path << ": not a readable image\n";
         ++failures;
         continue;
       }
-      auto detection = (*detector)->Detect(image, args->options);
+      // The frame budget counts from decoding, as in tod_server and tod bench.
+      DetectOptions options = args->options;
+      if (options.budget_ms > 0) {
+        const double decode_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - read_start)
+                .count();
+        options.budget_ms = std::max(1.0, options.budget_ms - decode_ms);
+      }
+      auto detection = (*detector)->Detect(image, options);
       if (!detection.ok()) {
         std::cerr << "tod: " << path << ": " << detection.status().message() << "\n";
         ++failures;

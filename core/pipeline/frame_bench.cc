@@ -15,6 +15,7 @@
 
 #include "core/pipeline/detection_output.h"
 #include "core/pipeline/edge_boxes_baseline.h"
+#include "core/pipeline/frame_budget.h"
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/obstacle_detector.h"
@@ -94,8 +95,7 @@ Result<FrameBenchRecord> TimeFrame(const ObstacleDetector& detector,
   bgr = decoded;
   // The frame budget counts from the start of decoding, as the server counts it.
   DetectOptions detect = options;
-  if (detect.budget_ms > 0)
-    detect.budget_ms = std::max(1.0, detect.budget_ms - MsBetween(start, decoded_at));
+  detect.budget_ms = BudgetLeftMs(detect.budget_ms, MsBetween(start, decoded_at));
   const auto detection = detector.Detect(bgr, detect);
   if (!detection.ok()) return detection.status();
   const Clock::time_point encode_start = Clock::now();

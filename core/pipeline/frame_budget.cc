@@ -21,6 +21,12 @@ FrameBudget::FrameBudget(Clock::time_point start, double budget_ms,
   regression_deadline_ = At(start, budget_ms * std::clamp(params.regression_end, 0.0, 1.0));
 }
 
+double BudgetLeftMs(double budget_ms, double spent_ms) {
+  if (!(budget_ms > 0)) return budget_ms;
+  constexpr double kExhausted = 1e-3;  // positive: a budget, past at once
+  return std::max(kExhausted, budget_ms - spent_ms);
+}
+
 std::chrono::steady_clock::time_point ShareOfRemaining(
     std::chrono::steady_clock::time_point stage_deadline, double weight, double remaining_weight) {
   using Clock = std::chrono::steady_clock;

@@ -40,6 +40,11 @@ class FrameBudget {
   Clock::time_point regression_deadline_ = Clock::time_point::max();
 };
 
+// What is left of a frame budget (budget_ms, <= 0: none) once spent_ms went on work before
+// Detect (decoding): still a budget, even when nothing is left, so that Detect then degrades
+// as far as it can instead of running unbounded.
+double BudgetLeftMs(double budget_ms, double spent_ms);
+
 // Deadlines for consecutive pieces of work sharing [now, stage_deadline): piece i gets
 // now + (stage_deadline - now) * weight_i / (weight_i + ... + weight_last), asked again when
 // piece i starts, so time a piece leaves unused passes on to the next ones.

@@ -4,6 +4,7 @@
 #include <opencv2/core/utility.hpp>
 #include <utility>
 
+#include "core/pipeline/frame_budget.h"
 #include "server/core/image_header.h"
 #include "server/metrics.h"
 
@@ -256,10 +257,8 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
   options.want_probability_map = request.encode_map_png;
   options.threads = config_.threads_per_request;
   options.budget_ms = EffectiveBudgetMs(config_.frame_budget_ms, request.options.budget_ms);
-  // Decoding already spent part of it (a budget this leaves at 0 or below still limits: the
-  // pipeline then degrades as much as it can).
-  if (options.budget_ms > 0)
-    options.budget_ms = std::max(1.0, options.budget_ms - MillisecondsSince(started));
+  // Decoding already spent part of it.
+  options.budget_ms = BudgetLeftMs(options.budget_ms, MillisecondsSince(started));
   // Asked between the pipeline's stages; the Status it returns is only a signal here: the result
   // is rebuilt from the reason below so the message says where the work stopped.
   int boundaries = 0;  // stage boundaries passed, for the message
