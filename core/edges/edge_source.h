@@ -4,12 +4,12 @@
 //  - "sed": OpenCV's StructuredEdgeDetection with a model file the user supplies.
 #pragma once
 
-#include <iosfwd>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
+#include "core/base/binary_io.h"
 #include "core/base/status.h"
 #include "core/edges/edge_channels.h"
 #include "core/forest/random_forest.h"
@@ -86,8 +86,9 @@ class PixelEdgeClassifier : public EdgeSource {
   // Of the last TryTrain: (share of negative cells sampled) / (share of boundary cells sampled),
   // the odds factor that undoes the balanced sampling (PriorCorrection). Not stored in the file.
   double sampled_odds_scale() const { return sampled_odds_scale_; }
-  Status Save(std::ostream& out) const;
-  static Result<PixelEdgeClassifier> Load(std::istream& in, const std::string& what);
+  // The file format is in edge_source_pixel_forest.cc; Load's errors name the reader's source.
+  Status Save(BinaryWriter& out) const;
+  static Result<PixelEdgeClassifier> Load(BinaryReader& in);
 
  private:
   RandomForest forest_;
@@ -96,8 +97,8 @@ class PixelEdgeClassifier : public EdgeSource {
 };
 
 // Builds the edge source of a model bundle. kind "gradient": default parameters, `in` unused;
-// "pixel_forest": PixelEdgeClassifier::Load(*in, what); "sed": `what` is the model file path.
-Result<std::unique_ptr<EdgeSource>> LoadEdgeSource(const std::string& kind, std::istream* in,
+// "pixel_forest": PixelEdgeClassifier::Load(*in); "sed": `what` is the model file path.
+Result<std::unique_ptr<EdgeSource>> LoadEdgeSource(const std::string& kind, BinaryReader* in,
                                                    const std::string& what);
 
 }  // namespace tod

@@ -1,5 +1,4 @@
 // One entry point for the model bundle to build whichever edge source it was trained with.
-#include <istream>
 #include <memory>
 #include <string>
 
@@ -7,16 +6,15 @@
 
 namespace tod {
 
-Result<std::unique_ptr<EdgeSource>> LoadEdgeSource(const std::string& kind, std::istream* in,
+Result<std::unique_ptr<EdgeSource>> LoadEdgeSource(const std::string& kind, BinaryReader* in,
                                                    const std::string& what) {
   if (kind == "gradient") return CreateGradientEdgeSource();
   if (kind == "sed") return CreateSedEdgeSource(what);
   if (kind == "pixel_forest") {
     if (in == nullptr) {
-      return Status::InvalidArgument("edge source 'pixel_forest' from '" + what +
-                                     "': no input stream");
+      return Status::InvalidArgument("edge source 'pixel_forest' from '" + what + "': no input");
     }
-    Result<PixelEdgeClassifier> classifier = PixelEdgeClassifier::Load(*in, what);
+    Result<PixelEdgeClassifier> classifier = PixelEdgeClassifier::Load(*in);
     if (!classifier.ok()) return classifier.status();
     return std::unique_ptr<EdgeSource>(
         std::make_unique<PixelEdgeClassifier>(std::move(classifier).value()));

@@ -2,15 +2,13 @@
 // pipeline" step 1. Everything (channels, samples, predictions) lives on the stride-2 cell grid
 // of edge_channels.h, as SED evaluates at stride 2; Compute() upsamples bilinearly.
 #include <algorithm>
-#include <array>
 #include <cstdint>
-#include <istream>
 #include <numeric>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
-#include <ostream>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/edges/edge_channels.h"
@@ -21,28 +19,12 @@
 namespace tod {
 namespace {
 
-constexpr std::array<char, 8> kMagic = {'T', 'O', 'D', 'P', 'X', 'E', 'D', 'G'};
+constexpr std::string_view kMagic("TODPXEDG", 8);
 constexpr std::uint32_t kFormatVersion = 1;
-constexpr std::int32_t kMaxSmoothRadius = 16;  // sanity bound when loading
+constexpr std::uint32_t kMaxSmoothRadius = 16;  // sanity bound when loading
 
 // A cell is a positive sample when at least half of its 2x2 pixels are near a boundary.
 constexpr float kPositiveNearFraction = 0.5f;
-
-void WriteU32(std::ostream& out, std::uint32_t value) {
-  const char bytes[4] = {static_cast<char>(value & 0xff), static_cast<char>((value >> 8) & 0xff),
-                         static_cast<char>((value >> 16) & 0xff),
-                         static_cast<char>((value >> 24) & 0xff)};
-  out.write(bytes, 4);
-}
-
-bool ReadU32(std::istream& in, std::uint32_t* value) {
-  unsigned char bytes[4];
-  if (!in.read(reinterpret_cast<char*>(bytes), 4)) return false;
-  *value = static_cast<std::uint32_t>(bytes[0]) | (static_cast<std::uint32_t>(bytes[1]) << 8) |
-           (static_cast<std::uint32_t>(bytes[2]) << 16) |
-           (static_cast<std::uint32_t>(bytes[3]) << 24);
-  return true;
-}
 
 // Picks up to `count` distinct entries of `pool` (partial Fisher-Yates).
 std::vector<int> SampleWithoutReplacement(std::vector<int> pool, std::size_t count,
@@ -179,52 +161,43 @@ cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr) const {
   return edge;
 }
 
-Status PixelEdgeClassifier::Save(std::ostream& out) const {
+// The file: header (binary_io.h), u32 feature layout version, u32 channel count, u32 feature
+// count, u32 image and channel smoothing radii, then the forest (random_forest_io.cc).
+Status PixelEdgeClassifier::Save(BinaryWriter& out) const {
   if (forest_.empty()) {
     return Status::FailedPrecondition("pixel edge classifier: cannot save an untrained model");
   }
-  out.write(kMagic.data(), kMagic.size());
-  WriteU32(out, kFormatVersion);
-  WriteU32(out, static_cast<std::uint32_t>(kPixelFeatureLayoutVersion));
-  WriteU32(out, static_cast<std::uint32_t>(kNumEdgeChannels));
-  WriteU32(out, static_cast<std::uint32_t>(NumPixelFeatures()));
-  WriteU32(out, static_cast<std::uint32_t>(std::max(channel_params_.image_smooth_radius, 0)));
-  WriteU32(out, static_cast<std::uint32_t>(std::max(channel_params_.channel_smooth_radius, 0)));
-  if (!out) return Status::Internal("pixel edge classifier: writing the header failed");
+  out.Header(kMagic, kFormatVersion);
+  out.U32(static_cast<std::uint32_t>(kPixelFeatureLayoutVersion));
+  out.U32(static_cast<std::uint32_t>(kNumEdgeChannels));
+  out.U32(static_cast<std::uint32_t>(NumPixelFeatures()));
+  out.U32(static_cast<std::uint32_t>(std::max(channel_params_.image_smooth_radius, 0)));
+  out.U32(static_cast<std::uint32_t>(std::max(channel_params_.channel_smooth_radius, 0)));
   return forest_.Save(out);
 }
 
-Result<PixelEdgeClassifier> PixelEdgeClassifier::Load(std::istream& in, const std::string& what) {
-  const std::string prefix = "pixel edge classifier '" + what + "': ";
-  std::array<char, kMagic.size()> magic{};
-  if (!in.read(magic.data(), magic.size())) {
-    return Status::DataLoss(prefix + "truncated before the end of the magic number");
-  }
-  if (magic != kMagic) {
-    return Status::InvalidArgument(prefix + "not a pixel edge classifier (bad magic number)");
-  }
-  std::array<std::uint32_t, 6> header{};
-  for (std::uint32_t& field : header) {
-    if (!ReadU32(in, &field)) return Status::DataLoss(prefix + "truncated header");
-  }
-  const auto [format, layout, channels, features, image_radius, channel_radius] = header;
-  if (format != kFormatVersion) {
-    return Status::FailedPrecondition(prefix + "format version " + std::to_string(format) +
-                                      ", this build reads " + std::to_string(kFormatVersion));
-  }
+Result<PixelEdgeClassifier> PixelEdgeClassifier::Load(BinaryReader& in) {
+  if (Status s = in.Header(kMagic, kFormatVersion, "pixel edge classifier"); !s.ok()) return s;
+  const std::uint32_t layout = in.U32("the feature layout");
+  const std::uint32_t channels = in.U32("the channel count");
+  const std::uint32_t features = in.U32("the feature count");
+  const std::uint32_t image_radius = in.U32("the image smoothing radius");
+  const std::uint32_t channel_radius = in.U32("the channel smoothing radius");
+  if (!in.ok()) return in.status();
+  const std::string prefix = in.source() + ": pixel edge classifier ";
   if (layout != static_cast<std::uint32_t>(kPixelFeatureLayoutVersion) ||
       channels != static_cast<std::uint32_t>(kNumEdgeChannels) ||
       features != static_cast<std::uint32_t>(NumPixelFeatures())) {
     return Status::FailedPrecondition(
-        prefix + "feature layout " + std::to_string(layout) + " with " + std::to_string(channels) +
-        " channels / " + std::to_string(features) + " features, this build uses layout " +
-        std::to_string(kPixelFeatureLayoutVersion) + " with " + std::to_string(kNumEdgeChannels) +
-        " / " + std::to_string(NumPixelFeatures()));
+        prefix + "has feature layout " + std::to_string(layout) + " with " +
+        std::to_string(channels) + " channels / " + std::to_string(features) +
+        " features, this build uses layout " + std::to_string(kPixelFeatureLayoutVersion) +
+        " with " + std::to_string(kNumEdgeChannels) + " / " + std::to_string(NumPixelFeatures()));
   }
   if (image_radius > kMaxSmoothRadius || channel_radius > kMaxSmoothRadius) {
-    return Status::DataLoss(prefix + "smoothing radius out of range (corrupt header)");
+    return in.Corrupt("pixel edge classifier smoothing radius out of range (corrupt header)");
   }
-  Result<RandomForest> forest = RandomForest::Load(in, what);
+  Result<RandomForest> forest = RandomForest::Load(in);
   if (!forest.ok()) return forest.status();
   if (forest->empty() || forest->num_features() != NumPixelFeatures()) {
     return Status::FailedPrecondition(prefix + "forest has " + std::to_string(forest->num_trees()) +

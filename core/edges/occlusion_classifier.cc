@@ -4,10 +4,8 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <istream>
-#include <ostream>
 #include <random>
+#include <string_view>
 #include <utility>
 
 #include "core/edges/occlusion_features.h"
@@ -15,7 +13,7 @@
 namespace tod {
 namespace {
 
-constexpr char kMagic[8] = {'T', 'O', 'D', 'O', 'C', 'C', 'L', '\0'};
+constexpr std::string_view kMagic("TODOCCL\0", 8);
 constexpr std::uint32_t kFormatVersion = 1;
 // Negatives kept per positive when balancing the training pairs (§3.4 step 4).
 constexpr size_t kNegativesPerPositive = 4;
@@ -109,23 +107,6 @@ std::vector<RegionTruth> RegionTruths(const cv::Mat1i& superpixel_labels, int co
   }
   return truths;
 }
-
-template <typename T>
-void WriteValue(std::ostream& out, const T& value) {
-  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
-}
-
-template <typename T>
-Status ReadValue(std::istream& in, T& value, const std::string& what, const char* field) {
-  if (!in.read(reinterpret_cast<char*>(&value), sizeof(T))) {
-    return Status::DataLoss(what + ": occlusion classifier truncated while reading " + field);
-  }
-  return Status::Ok();
-}
-
-}  // namespace
-
-namespace {
 
 Status ValidateOcclusionParams(const OcclusionParams& params) {
   if (!(params.floor >= 0.f && params.floor <= 1.f)) {
@@ -304,90 +285,62 @@ cv::Mat1f OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::Mat1f& en
   return std::move(painted).value();
 }
 
-Status OcclusionClassifier::Save(std::ostream& out) const {
-  out.write(kMagic, sizeof(kMagic));
-  WriteValue(out, kFormatVersion);
-  WriteValue(out, static_cast<std::uint32_t>(kNumOcclusionFeatures));
-  WriteValue(out, params_.floor);
-  WriteValue(out, params_.max_void_fraction);
+// The file: header (binary_io.h), u32 feature count, the parameters (f32 floor, f64
+// max_void_fraction, i32 num_trees, max_features, min_leaf_size, max_depth, f64 sample_fraction,
+// u64 seed, i32 threads), u8 trained flag, then the forest (random_forest_io.cc) when trained.
+Status OcclusionClassifier::Save(BinaryWriter& out) const {
+  out.Header(kMagic, kFormatVersion);
+  out.U32(static_cast<std::uint32_t>(kNumOcclusionFeatures));
+  out.F32(params_.floor);
+  out.F64(params_.max_void_fraction);
   const ForestParams& f = params_.forest;
-  WriteValue(out, static_cast<std::int32_t>(f.num_trees));
-  WriteValue(out, static_cast<std::int32_t>(f.max_features));
-  WriteValue(out, static_cast<std::int32_t>(f.min_leaf_size));
-  WriteValue(out, static_cast<std::int32_t>(f.max_depth));
-  WriteValue(out, f.sample_fraction);
-  WriteValue(out, f.seed);
-  WriteValue(out, static_cast<std::int32_t>(f.threads));
-  WriteValue(out, static_cast<std::uint8_t>(trained() ? 1 : 0));
-  if (!out) return Status::Internal("occlusion classifier: write failed");
+  out.I32(f.num_trees);
+  out.I32(f.max_features);
+  out.I32(f.min_leaf_size);
+  out.I32(f.max_depth);
+  out.F64(f.sample_fraction);
+  out.U64(f.seed);
+  out.I32(f.threads);
+  out.U8(trained() ? 1 : 0);
   if (trained()) return forest_.Save(out);
   return Status::Ok();
 }
 
-Result<OcclusionClassifier> OcclusionClassifier::Load(std::istream& in, const std::string& what) {
-  char magic[sizeof(kMagic)];
-  if (!in.read(magic, sizeof(magic))) {
-    return Status::DataLoss(what + ": occlusion classifier truncated while reading magic");
-  }
-  if (std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) {
-    return Status::InvalidArgument(what + ": not an occlusion classifier (bad magic)");
-  }
-  std::uint32_t version = 0;
-  std::uint32_t num_features = 0;
+Result<OcclusionClassifier> OcclusionClassifier::Load(BinaryReader& in) {
+  if (Status s = in.Header(kMagic, kFormatVersion, "occlusion classifier"); !s.ok()) return s;
   OcclusionClassifier c;
-  std::int32_t num_trees = 0;
-  std::int32_t max_features = 0;
-  std::int32_t min_leaf = 0;
-  std::int32_t max_depth = 0;
-  std::int32_t threads = 0;
-  std::uint8_t trained = 0;
-  if (Status s = ReadValue(in, version, what, "version"); !s.ok()) return s;
-  if (version != kFormatVersion) {
-    return Status::FailedPrecondition(what + ": occlusion classifier format version " +
-                                      std::to_string(version) + ", expected " +
-                                      std::to_string(kFormatVersion));
-  }
+  const std::uint32_t num_features = in.U32("num_features");
+  c.params_.floor = in.F32("floor");
+  c.params_.max_void_fraction = in.F64("max_void_fraction");
   ForestParams& f = c.params_.forest;
-  const Status reads[] = {
-      ReadValue(in, num_features, what, "num_features"),
-      ReadValue(in, c.params_.floor, what, "floor"),
-      ReadValue(in, c.params_.max_void_fraction, what, "max_void_fraction"),
-      ReadValue(in, num_trees, what, "forest.num_trees"),
-      ReadValue(in, max_features, what, "forest.max_features"),
-      ReadValue(in, min_leaf, what, "forest.min_leaf_size"),
-      ReadValue(in, max_depth, what, "forest.max_depth"),
-      ReadValue(in, f.sample_fraction, what, "forest.sample_fraction"),
-      ReadValue(in, f.seed, what, "forest.seed"),
-      ReadValue(in, threads, what, "forest.threads"),
-      ReadValue(in, trained, what, "trained flag"),
-  };
-  for (const Status& s : reads) {
-    if (!s.ok()) return s;  // the first failed read names the field where the stream ended
-  }
-  f.num_trees = num_trees;
-  f.max_features = max_features;
-  f.min_leaf_size = min_leaf;
-  f.max_depth = max_depth;
-  f.threads = threads;
+  f.num_trees = in.I32("forest.num_trees");
+  f.max_features = in.I32("forest.max_features");
+  f.min_leaf_size = in.I32("forest.min_leaf_size");
+  f.max_depth = in.I32("forest.max_depth");
+  f.sample_fraction = in.F64("forest.sample_fraction");
+  f.seed = in.U64("forest.seed");
+  f.threads = in.I32("forest.threads");
+  const std::uint8_t trained = in.U8("the trained flag");
+  if (!in.ok()) return in.status();  // names the field where the bytes ran out
   if (num_features != static_cast<std::uint32_t>(kNumOcclusionFeatures)) {
-    return Status::FailedPrecondition(what + ": occlusion classifier has " +
+    return Status::FailedPrecondition(in.source() + ": occlusion classifier has " +
                                       std::to_string(num_features) + " features, expected " +
                                       std::to_string(kNumOcclusionFeatures));
   }
   if (!(c.params_.floor >= 0.f && c.params_.floor <= 1.f)) {
-    return Status::DataLoss(what + ": occlusion classifier floor outside [0,1]");
+    return in.Corrupt("occlusion classifier floor outside [0,1]");
   }
   if (!(c.params_.max_void_fraction >= 0.0 && c.params_.max_void_fraction <= 1.0)) {
-    return Status::DataLoss(what + ": occlusion classifier max_void_fraction outside [0,1]");
+    return in.Corrupt("occlusion classifier max_void_fraction outside [0,1]");
   }
-  if (trained > 1) return Status::DataLoss(what + ": occlusion classifier bad trained flag");
+  if (trained > 1) return in.Corrupt("occlusion classifier bad trained flag");
   if (trained == 1) {
-    Result<RandomForest> forest = RandomForest::Load(in, what);
+    Result<RandomForest> forest = RandomForest::Load(in);
     if (!forest.ok()) return forest.status();
     if (forest->empty() || forest->num_features() != kNumOcclusionFeatures) {
-      return Status::DataLoss(what + ": occlusion classifier forest has " +
-                              std::to_string(forest->num_features()) + " features, expected " +
-                              std::to_string(kNumOcclusionFeatures));
+      return in.Corrupt("occlusion classifier forest has " +
+                        std::to_string(forest->num_features()) + " features, expected " +
+                        std::to_string(kNumOcclusionFeatures));
     }
     c.forest_ = std::move(forest).value();
   }

@@ -4,11 +4,11 @@
 // The untrained fallback scores a boundary by its mean Ê, rescaled to [0,1] per image.
 #pragma once
 
-#include <iosfwd>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
+#include "core/base/binary_io.h"
 #include "core/base/status.h"
 #include "core/edges/sticky_superpixels.h"
 #include "core/forest/random_forest.h"
@@ -68,8 +68,9 @@ class OcclusionClassifier {
   Result<cv::Mat1f> PaintChecked(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
                                  const Superpixels& superpixels) const;
 
-  Status Save(std::ostream& out) const;
-  static Result<OcclusionClassifier> Load(std::istream& in, const std::string& what);
+  // The file format is in occlusion_classifier.cc; Load's errors name the reader's source.
+  Status Save(BinaryWriter& out) const;
+  static Result<OcclusionClassifier> Load(BinaryReader& in);
 
  private:
   OcclusionParams params_;

@@ -5,11 +5,11 @@
 #pragma once
 
 #include <cstdint>
-#include <iosfwd>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
+#include "core/base/binary_io.h"
 #include "core/base/status.h"
 #include "core/forest/compact_forest.h"
 #include "core/forest/forest_node.h"
@@ -61,9 +61,10 @@ class RandomForest {
   // Number of leaves of one tree (for tests and diagnostics); 0 for an index out of range.
   int CountLeaves(int tree) const;
 
-  Status Save(std::ostream& out) const;
-  // `what` names the source in error messages (e.g. the file path).
-  static Result<RandomForest> Load(std::istream& in, const std::string& what);
+  // The file format is in random_forest_io.cc. Save never fails (a Status for the model
+  // convention of binary_io.h); Load's errors name the reader's source (e.g. the file path).
+  Status Save(BinaryWriter& out) const;
+  static Result<RandomForest> Load(BinaryReader& in);
 
  private:
   // See forest_node.h: 12 bytes, children adjacent (right = left + 1) and after their parent.

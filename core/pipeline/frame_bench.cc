@@ -1,7 +1,5 @@
 #include "core/pipeline/frame_bench.h"
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -13,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 
+#include "core/base/memory_usage.h"
 #include "core/pipeline/detection_output.h"
 #include "core/pipeline/edge_boxes_baseline.h"
 #include "core/pipeline/frame_budget.h"
@@ -185,12 +184,6 @@ Spread SpreadOf(std::vector<double> values) {
   s.p90 = values[std::clamp<std::size_t>(rank, 1, n) - 1];
   s.max = values.back();
   return s;
-}
-
-double PeakRssMb() {
-  rusage usage{};
-  if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
 
 Result<FrameBenchReport> RunFrameBench(const ObstacleDetector& detector,

@@ -85,9 +85,6 @@ Result<FrameBenchReport> RunFrameBench(const ObstacleDetector& detector,
                                        const std::vector<std::string>& frames,
                                        const BenchOptions& options);
 
-// The process's peak resident set size so far (getrusage), in MiB.
-double PeakRssMb();
-
 // The tables a person reads: per stage median / p90 / max, the counters, Edge Boxes and its
 // ratio, peak RSS.
 std::string FormatBenchReport(const FrameBenchReport& report);

@@ -8,6 +8,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/base/atomic_file.h"
+#include "core/base/binary_io.h"
+#include "core/base/checksum.h"
+
 namespace tod {
 namespace fs = std::filesystem;
 namespace {
@@ -18,24 +22,14 @@ constexpr const char* kOcclusionFile = "occlusion.bin";
 constexpr const char* kOrdrFile = "ordr.bin";
 constexpr const char* kObdrFile = "obdr.bin";
 
-// 64-bit FNV-1a: enough to detect a truncated or altered file, cheap to compute.
-std::string Fnv1a(const std::string& bytes) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
+// The manifest's checksum of a file ("fnv1a64"), as hex. Its basis is a digit short of FNV's
+// standard offset basis (14695981039346656037): every manifest written so far carries checksums
+// made with it, so it stays, as part of the bundle format.
+constexpr std::uint64_t kManifestChecksumBasis = 1469598103934665603ULL;
+std::string ChecksumHex(const std::string& bytes) {
   std::ostringstream s;
-  s << std::hex << h;
+  s << std::hex << Fnv1a64(bytes, kManifestChecksumBasis);
   return s.str();
-}
-
-Status WriteFile(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  out.flush();
-  if (!out) return Status::Internal("cannot write " + path.string());
-  return Status::Ok();
 }
 
 Result<std::string> ReadFile(const fs::path& path) {
@@ -46,14 +40,6 @@ Result<std::string> ReadFile(const fs::path& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-template <typename Model>
-Result<std::string> Serialise(const Model& model) {
-  std::ostringstream out(std::ios::binary);
-  Status st = model.Save(out);
-  if (!st.ok()) return st;
-  return out.str();
 }
 
 }  // namespace
@@ -84,9 +70,9 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   nlohmann::json files = nlohmann::json::object();
   auto add = [&](const char* name, const Result<std::string>& bytes) -> Status {
     if (!bytes.ok()) return bytes.status();
-    Status st = WriteFile(tmp / name, *bytes);
+    Status st = WriteFileAtomically((tmp / name).string(), *bytes);
     if (!st.ok()) return st;
-    files[name] = {{"bytes", bytes->size()}, {"fnv1a64", Fnv1a(*bytes)}};
+    files[name] = {{"bytes", bytes->size()}, {"fnv1a64", ChecksumHex(*bytes)}};
     return Status::Ok();
   };
   Status st;
@@ -94,16 +80,16 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
     const auto* classifier = dynamic_cast<const PixelEdgeClassifier*>(bundle.edges.get());
     if (classifier == nullptr)
       return Status::InvalidArgument("pixel_forest bundle without classifier");
-    st = add(kEdgesFile, Serialise(*classifier));
+    st = add(kEdgesFile, EncodeModel(*classifier));
     if (!st.ok()) return st;
   } else if (bundle.edge_kind == "sed") {
     auto bytes = ReadFile(sed_model_source);
     st = add("sed_model.yml.gz", bytes);
     if (!st.ok()) return st;
   }
-  if ((st = add(kOcclusionFile, Serialise(bundle.occlusion))); !st.ok()) return st;
-  if ((st = add(kOrdrFile, Serialise(bundle.ordr))); !st.ok()) return st;
-  if ((st = add(kObdrFile, Serialise(bundle.obdr))); !st.ok()) return st;
+  if ((st = add(kOcclusionFile, EncodeModel(bundle.occlusion))); !st.ok()) return st;
+  if ((st = add(kOrdrFile, EncodeModel(bundle.ordr))); !st.ok()) return st;
+  if ((st = add(kObdrFile, EncodeModel(bundle.obdr))); !st.ok()) return st;
 
   nlohmann::json manifest;
   manifest["format_version"] = kBundleFormatVersion;
@@ -117,7 +103,8 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   manifest["training"] = bundle.training;
   manifest["eval"] = bundle.eval;
   manifest["files"] = files;
-  if ((st = WriteFile(tmp / kManifest, manifest.dump(2) + "\n")); !st.ok()) return st;
+  if ((st = WriteFileAtomically((tmp / kManifest).string(), manifest.dump(2) + "\n")); !st.ok())
+    return st;
 
   // Swap in: move an existing bundle aside, rename the new one, then delete the old one.
   const fs::path old = target.parent_path() /
@@ -189,15 +176,14 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
       return Status::DataLoss(path.string() + ": truncated or altered (" +
                               std::to_string(bytes->size()) + " bytes, manifest says " +
                               std::to_string(expected) + ")");
-    if (Fnv1a(*bytes) != entry.value("fnv1a64", ""))
+    if (ChecksumHex(*bytes) != entry.value("fnv1a64", ""))
       return Status::DataLoss(path.string() + ": checksum mismatch (file corrupted)");
     return bytes;
   };
   auto load_forest = [&](const char* name, RandomForest& forest) -> Status {
     auto bytes = checked(name);
     if (!bytes.ok()) return bytes.status();
-    std::istringstream in(*bytes, std::ios::binary);
-    auto loaded = RandomForest::Load(in, (root / name).string());
+    auto loaded = DecodeModel<RandomForest>(*bytes, (root / name).string());
     if (!loaded.ok()) return loaded.status();
     forest = std::move(*loaded);
     return Status::Ok();
@@ -208,8 +194,7 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
   {
     auto bytes = checked(kOcclusionFile);
     if (!bytes.ok()) return bytes.status();
-    std::istringstream in(*bytes, std::ios::binary);
-    auto loaded = OcclusionClassifier::Load(in, (root / kOcclusionFile).string());
+    auto loaded = DecodeModel<OcclusionClassifier>(*bytes, (root / kOcclusionFile).string());
     if (!loaded.ok()) return loaded.status();
     bundle.occlusion = std::move(*loaded);
     // No silent fallback: an untrained classifier would paint mean-Ê boundaries instead of the
@@ -228,8 +213,7 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
   if (bundle.edge_kind == "pixel_forest") {
     auto bytes = checked(kEdgesFile);
     if (!bytes.ok()) return bytes.status();
-    std::istringstream in(*bytes, std::ios::binary);
-    auto loaded = PixelEdgeClassifier::Load(in, (root / kEdgesFile).string());
+    auto loaded = DecodeModel<PixelEdgeClassifier>(*bytes, (root / kEdgesFile).string());
     if (!loaded.ok()) return loaded.status();
     bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*loaded));
   } else if (bundle.edge_kind == "gradient") {
@@ -261,13 +245,7 @@ Status UpdateManifestEval(const std::string& dir, const nlohmann::json& eval) {
     return Status::DataLoss(path.string() + ": not valid JSON");
   }
   manifest["eval"] = eval;
-  const fs::path tmp = path.string() + "." + std::to_string(::getpid()) + ".tmp";
-  Status st = WriteFile(tmp, manifest.dump(2) + "\n");
-  if (!st.ok()) return st;
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) return Status::Internal("cannot rename " + tmp.string() + ": " + ec.message());
-  return Status::Ok();
+  return WriteFileAtomically(path.string(), manifest.dump(2) + "\n");
 }
 
 }  // namespace tod

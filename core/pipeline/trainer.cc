@@ -1,11 +1,10 @@
 #include "core/pipeline/trainer.h"
 
-#include <sys/resource.h>
-
 #include <atomic>
 #include <chrono>
 #include <mutex>
 
+#include "core/base/memory_usage.h"
 #include "core/edges/edge_labels.h"
 #include "core/pipeline/dataset_factory.h"
 #include "core/pipeline/frame_stages.h"
@@ -19,12 +18,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-double PeakRssMb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes
 }
 
 // One training run: the split, progress lines (each with the peak RSS so far), step timings.
@@ -203,6 +196,7 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
   const std::vector<int> which = ClassifierFrames(run, survey);
   PixelEdgeParams edge_params = options.edge_params;
   edge_params.forest.seed = options.seed;
+  if (options.threads > 0) edge_params.forest.threads = options.threads;  // --threads bounds all
   run.Say("pixel edge classifier: samples from " + std::to_string(which.size()) + " frames");
   const Box r1 = bundle.regions.layers.front();
   std::vector<EdgeSamples> per_frame(run.num_frames());
@@ -241,6 +235,7 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
   const std::vector<int> which = ClassifierFrames(run, survey);
   OcclusionParams params = options.occlusion_params;
   params.forest.seed = options.seed;
+  if (options.threads > 0) params.forest.threads = options.threads;
   run.Say("occlusion classifier: pairs from " + std::to_string(which.size()) + " frames");
   std::vector<OcclusionSamples> per_frame(run.num_frames());
   const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {

@@ -19,10 +19,12 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "core/base/atomic_file.h"
 #include "core/forest/random_forest.h"
 
 namespace {
@@ -84,7 +86,8 @@ tod::RandomForest TrainOrLoad(const Case& c, const std::string& cache_dir) {
       cache_dir.empty() ? "" : (std::filesystem::path(cache_dir) / (c.name + ".forest")).string();
   if (!path.empty() && std::filesystem::exists(path)) {
     std::ifstream in(path, std::ios::binary);
-    tod::Result<tod::RandomForest> loaded = tod::RandomForest::Load(in, path);
+    const std::string file((std::istreambuf_iterator<char>(in)), {});
+    tod::Result<tod::RandomForest> loaded = tod::DecodeModel<tod::RandomForest>(file, path);
     if (loaded.ok()) return std::move(loaded).value();
     std::fprintf(stderr, "%s; retraining\n", loaded.status().message().c_str());
   }
@@ -96,8 +99,8 @@ tod::RandomForest TrainOrLoad(const Case& c, const std::string& cache_dir) {
                static_cast<long long>(forest.num_nodes()));
   if (!path.empty()) {
     std::filesystem::create_directories(cache_dir);
-    std::ofstream out(path, std::ios::binary);
-    if (!forest.Save(out).ok()) std::fprintf(stderr, "could not cache %s\n", path.c_str());
+    if (!tod::WriteFileAtomically(path, tod::EncodeModel(forest).value()).ok())
+      std::fprintf(stderr, "could not cache %s\n", path.c_str());
   }
   return forest;
 }

@@ -10,12 +10,13 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <opencv2/ml.hpp>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "core/base/atomic_file.h"
 #include "core/forest/random_forest.h"
 
 namespace {
@@ -79,16 +80,15 @@ void Ours(const Data& train, const Data& test, int threads, Row& row) {
   const double predict_s = Seconds([&] { predicted = forest.PredictBatch(test.x); });
   row.predict_ms_per_1000.push_back(1000.0 * predict_s * 1000.0 / test.x.rows);
   row.mse.push_back(Mse(predicted, test.y));
-  std::ostringstream out;
-  if (!forest.Save(out).ok()) std::fprintf(stderr, "save failed\n");
-  const std::string bytes = out.str();
+  const std::string bytes = tod::EncodeModel(forest).value();  // a forest's Save cannot fail
   row.bytes = static_cast<double>(bytes.size());
   const std::string path = (std::filesystem::temp_directory_path() / "bench_forest.bin").string();
-  std::ofstream(path, std::ios::binary)
-      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!tod::WriteFileAtomically(path, bytes).ok())
+    std::fprintf(stderr, "cannot write %s\n", path.c_str());
   row.load_ms.push_back(1000.0 * Seconds([&] {
                           std::ifstream in(path, std::ios::binary);
-                          const auto loaded = tod::RandomForest::Load(in, path);
+                          const std::string file((std::istreambuf_iterator<char>(in)), {});
+                          const auto loaded = tod::DecodeModel<tod::RandomForest>(file, path);
                           if (!loaded.ok())
                             std::fprintf(stderr, "%s\n", loaded.status().message().c_str());
                         }));

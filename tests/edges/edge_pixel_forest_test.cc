@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/edges/edge_labels.h"
@@ -118,35 +118,33 @@ TEST(PixelEdgeClassifier, TinyCropsKeepTheirSize) {
 }
 
 TEST(PixelEdgeClassifier, SaveLoadRoundTripGivesIdenticalMaps) {
-  std::stringstream stream;
-  ASSERT_TRUE(Trained().Save(stream).ok());
-  const Result<PixelEdgeClassifier> loaded = PixelEdgeClassifier::Load(stream, "edges.bin");
+  const Result<std::string> bytes = EncodeModel(Trained());
+  ASSERT_TRUE(bytes.ok());
+  const Result<PixelEdgeClassifier> loaded = DecodeModel<PixelEdgeClassifier>(*bytes, "edges.bin");
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   const cv::Mat3b image = MakeFrame(200).image;
   EXPECT_EQ(cv::norm(Trained().Compute(image), loaded->Compute(image), cv::NORM_INF), 0.0);
 }
 
 TEST(PixelEdgeClassifier, TruncatedOrCorruptStreamsAreErrorsNamingTheSource) {
-  std::ostringstream out;
-  ASSERT_TRUE(Trained().Save(out).ok());
-  const std::string bytes = out.str();
+  const Result<std::string> saved = EncodeModel(Trained());
+  ASSERT_TRUE(saved.ok());
+  const std::string& bytes = *saved;
   for (const std::size_t length : {std::size_t{0}, std::size_t{5}, std::size_t{8}, std::size_t{20},
                                    std::size_t{32}, bytes.size() / 2, bytes.size() - 1}) {
-    std::istringstream in(bytes.substr(0, length));
-    const Result<PixelEdgeClassifier> loaded = PixelEdgeClassifier::Load(in, "cut.bin");
+    const Result<PixelEdgeClassifier> loaded =
+        DecodeModel<PixelEdgeClassifier>(std::string_view(bytes).substr(0, length), "cut.bin");
     ASSERT_FALSE(loaded.ok()) << "length " << length;
     EXPECT_NE(loaded.status().message().find("cut.bin"), std::string::npos)
         << loaded.status().message();
   }
   std::string bad_magic = bytes;
   bad_magic[0] = 'X';
-  std::istringstream magic_in(bad_magic);
-  EXPECT_EQ(PixelEdgeClassifier::Load(magic_in, "m.bin").status().code(),
+  EXPECT_EQ(DecodeModel<PixelEdgeClassifier>(bad_magic, "m.bin").status().code(),
             StatusCode::kInvalidArgument);
   std::string other_layout = bytes;
   other_layout[20] = static_cast<char>(other_layout[20] + 1);  // feature count, low byte
-  std::istringstream layout_in(other_layout);
-  EXPECT_EQ(PixelEdgeClassifier::Load(layout_in, "l.bin").status().code(),
+  EXPECT_EQ(DecodeModel<PixelEdgeClassifier>(other_layout, "l.bin").status().code(),
             StatusCode::kFailedPrecondition);
 }
 
@@ -167,8 +165,7 @@ TEST(PixelEdgeClassifier, BadTrainingInputIsAnError) {
   const PixelEdgeClassifier untrained;
   EXPECT_FALSE(untrained.trained());
   EXPECT_EQ(cv::countNonZero(untrained.Compute(no_boundary.image)), 0);
-  std::ostringstream out;
-  EXPECT_FALSE(untrained.Save(out).ok());
+  EXPECT_FALSE(EncodeModel(untrained).ok());
 }
 
 }  // namespace

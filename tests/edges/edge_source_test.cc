@@ -4,7 +4,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 namespace tod {
@@ -117,7 +116,7 @@ TEST(LoadEdgeSource, BuildsGradientAndRejectsUnknownKinds) {
   const auto no_stream = LoadEdgeSource("pixel_forest", nullptr, "bundle.tod");
   EXPECT_FALSE(no_stream.ok());
 
-  std::istringstream junk("definitely not a model");
+  BinaryReader junk("definitely not a model", "bundle.tod");
   const auto bad_model = LoadEdgeSource("pixel_forest", &junk, "bundle.tod");
   ASSERT_FALSE(bad_model.ok());
   EXPECT_NE(bad_model.status().message().find("bundle.tod"), std::string::npos);

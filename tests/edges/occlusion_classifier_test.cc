@@ -7,8 +7,8 @@
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <set>
-#include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/edges/occlusion_features.h"
@@ -395,9 +395,9 @@ TEST_F(TrainedOcclusionTest, PaintOnlyOnBoundariesAndAtLeastFloor) {
 }
 
 TEST_F(TrainedOcclusionTest, SaveLoadRoundTrip) {
-  std::stringstream stream;
-  ASSERT_TRUE(classifier_->Save(stream).ok());
-  Result<OcclusionClassifier> loaded = OcclusionClassifier::Load(stream, "memory");
+  const Result<std::string> bytes = EncodeModel(*classifier_);
+  ASSERT_TRUE(bytes.ok());
+  Result<OcclusionClassifier> loaded = DecodeModel<OcclusionClassifier>(*bytes, "memory");
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_TRUE(loaded->trained());
   EXPECT_FLOAT_EQ(loaded->params().floor, classifier_->params().floor);
@@ -410,12 +410,12 @@ TEST_F(TrainedOcclusionTest, SaveLoadRoundTrip) {
 }
 
 TEST_F(TrainedOcclusionTest, TruncatedStreamIsDataLossNamingSource) {
-  std::stringstream stream;
-  ASSERT_TRUE(classifier_->Save(stream).ok());
-  const std::string bytes = stream.str();
-  for (const size_t length : {size_t{0}, size_t{5}, size_t{14}, size_t{40}, bytes.size() - 3}) {
-    std::istringstream cut(bytes.substr(0, length));
-    const Result<OcclusionClassifier> loaded = OcclusionClassifier::Load(cut, "occ.bin");
+  const Result<std::string> saved = EncodeModel(*classifier_);
+  ASSERT_TRUE(saved.ok());
+  const std::string& bytes = *saved;
+  for (size_t length = 0; length < bytes.size(); ++length) {
+    const Result<OcclusionClassifier> loaded =
+        DecodeModel<OcclusionClassifier>(std::string_view(bytes).substr(0, length), "occ.bin");
     ASSERT_FALSE(loaded.ok()) << "length " << length;
     EXPECT_EQ(loaded.status().code(), StatusCode::kDataLoss) << loaded.status().message();
     EXPECT_NE(loaded.status().message().find("occ.bin"), std::string::npos);
@@ -423,14 +423,14 @@ TEST_F(TrainedOcclusionTest, TruncatedStreamIsDataLossNamingSource) {
 }
 
 TEST(OcclusionClassifierIoTest, UntrainedRoundTripAndBadMagic) {
-  std::stringstream stream;
-  ASSERT_TRUE(OcclusionClassifier().Save(stream).ok());
-  Result<OcclusionClassifier> loaded = OcclusionClassifier::Load(stream, "m");
+  const Result<std::string> bytes = EncodeModel(OcclusionClassifier());
+  ASSERT_TRUE(bytes.ok());
+  Result<OcclusionClassifier> loaded = DecodeModel<OcclusionClassifier>(*bytes, "m");
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_FALSE(loaded->trained());
 
-  std::istringstream garbage("NOTANOCCLUSIONMODEL.....");
-  const Result<OcclusionClassifier> bad = OcclusionClassifier::Load(garbage, "g.bin");
+  const Result<OcclusionClassifier> bad =
+      DecodeModel<OcclusionClassifier>("NOTANOCCLUSIONMODEL.....", "g.bin");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("g.bin"), std::string::npos);
   EXPECT_NE(bad.status().message().find("magic"), std::string::npos);

@@ -8,7 +8,6 @@
 #include <cstring>
 #include <limits>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -45,8 +44,7 @@ RandomForest LoadHandBuilt(int num_features, const std::vector<std::int32_t>& ro
   std::uint64_t hash = 0xCBF29CE484222325ULL;
   for (const char c : bytes) hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001B3ULL;
   put(hash, 8);
-  std::istringstream in(bytes);
-  Result<RandomForest> loaded = RandomForest::Load(in, "hand-built");
+  Result<RandomForest> loaded = DecodeModel<RandomForest>(bytes, "hand-built");
   EXPECT_TRUE(loaded.ok()) << loaded.status().message();
   return loaded.ok() ? std::move(loaded).value() : RandomForest();
 }
@@ -198,9 +196,9 @@ TEST(BatchPrediction, RowsMayBeAViewIntoAWiderMatrix) {
 
 TEST(BatchPrediction, LoadedForestPredictsTheSameBatch) {
   const RandomForest forest = DeepForest();
-  std::stringstream stream;
-  ASSERT_TRUE(forest.Save(stream).ok());
-  Result<RandomForest> loaded = RandomForest::Load(stream, "round trip");
+  const Result<std::string> bytes = EncodeModel(forest);
+  ASSERT_TRUE(bytes.ok());
+  Result<RandomForest> loaded = DecodeModel<RandomForest>(*bytes, "round trip");
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   const Data test = MakeData(300, 3, 34);
   EXPECT_EQ(loaded.value().PredictBatch(test.x), forest.PredictBatch(test.x));

@@ -3,9 +3,10 @@
 #include <cstdint>
 #include <cstring>
 #include <random>
-#include <sstream>
 #include <string>
+#include <string_view>
 
+#include "core/base/checksum.h"
 #include "core/forest/random_forest.h"
 
 namespace tod {
@@ -29,22 +30,18 @@ RandomForest SmallForest() {
 }
 
 std::string Serialise(const RandomForest& forest) {
-  std::ostringstream out;
-  EXPECT_TRUE(forest.Save(out).ok());
-  return out.str();
+  Result<std::string> bytes = EncodeModel(forest);
+  EXPECT_TRUE(bytes.ok());
+  return bytes.ok() ? std::move(bytes).value() : std::string();
 }
 
 Result<RandomForest> Parse(const std::string& bytes) {
-  std::istringstream in(bytes);
-  return RandomForest::Load(in, "model.bin");
+  return DecodeModel<RandomForest>(bytes, "model.bin");
 }
 
 // FNV-1a, as the format specifies, to forge streams whose checksum is right but content wrong.
 void Reseal(std::string& bytes) {
-  std::uint64_t hash = 0xCBF29CE484222325ULL;
-  for (std::size_t i = 0; i + 8 < bytes.size(); ++i) {
-    hash = (hash ^ static_cast<unsigned char>(bytes[i])) * 0x100000001B3ULL;
-  }
+  const std::uint64_t hash = Fnv1a64(std::string_view(bytes).substr(0, bytes.size() - 8));
   for (int i = 0; i < 8; ++i) bytes[bytes.size() - 8 + i] = static_cast<char>(hash >> (8 * i));
 }
 

@@ -12,7 +12,6 @@
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -61,12 +60,12 @@ cv::Mat3b TinyFrame(int width, int height) {
 
 template <typename Model>
 std::string Saved(const Model& model) {
-  std::ostringstream out(std::ios::binary);
-  if (!model.Save(out).ok()) {
-    std::cerr << "fuzz_seed_gen: cannot save a model\n";
+  tod::Result<std::string> bytes = tod::EncodeModel(model);
+  if (!bytes.ok()) {
+    std::cerr << "fuzz_seed_gen: cannot save a model: " << bytes.status().message() << "\n";
     std::exit(1);
   }
-  return out.str();
+  return std::move(bytes).value();
 }
 
 tod::RandomForest TinyForest(int num_features, int trees, std::uint64_t seed) {

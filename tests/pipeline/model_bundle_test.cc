@@ -4,7 +4,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
+
+#include "core/base/binary_io.h"
+#include "tests/test_env.h"
 
 namespace tod {
 namespace {
@@ -48,6 +52,27 @@ class ModelBundleTest : public ::testing::Test {
   std::string Path(const std::string& name = "model") const { return (dir_ / name).string(); }
   fs::path dir_;
 };
+
+std::string FileBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The shipped bundle was written before core/base/binary_io.h served every model file: it must
+// still load, and writing its parts again must give the very same bytes (the formats did not
+// change).
+TEST(ShippedModelBundle, LoadsAndEveryLearnedFileReencodesByteForByte) {
+  const fs::path dir = fs::path(testing_env::SourceDir()) / "models" / "default";
+  const Result<ModelBundle> bundle = LoadModelBundle(dir.string());
+  ASSERT_TRUE(bundle.ok()) << bundle.status().message();
+  ASSERT_EQ(bundle->edge_kind, "pixel_forest");
+  const auto* edges = dynamic_cast<const PixelEdgeClassifier*>(bundle->edges.get());
+  ASSERT_NE(edges, nullptr);
+  EXPECT_EQ(EncodeModel(*edges).value(), FileBytes(dir / "edges.bin"));
+  EXPECT_EQ(EncodeModel(bundle->occlusion).value(), FileBytes(dir / "occlusion.bin"));
+  EXPECT_EQ(EncodeModel(bundle->ordr).value(), FileBytes(dir / "ordr.bin"));
+  EXPECT_EQ(EncodeModel(bundle->obdr).value(), FileBytes(dir / "obdr.bin"));
+}
 
 TEST_F(ModelBundleTest, UntrainedOcclusionClassifierIsAnErrorUnlessSwitchedOff) {
   ModelBundle b = SmallBundle(4);
