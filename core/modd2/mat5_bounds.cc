@@ -21,6 +21,12 @@ constexpr uint32_t kClassObject = 3;
 constexpr uint32_t kClassSparse = 5;
 constexpr uint32_t kLastNumericClass = 15;  // mxUINT64_CLASS
 constexpr int kMaxDepth = 32;
+constexpr unsigned kVersion5 = 0x0100;
+constexpr unsigned kVersion73 = 0x0200;
+
+Status NotValidMat(const std::string& what, const std::string& problem) {
+  return Status::DataLoss(what + ": not a valid MAT file (" + problem + ")");
+}
 
 class Walker {
  public:
@@ -51,9 +57,7 @@ class Walker {
                  : (uint32_t{b[3]} << 24) | (uint32_t{b[2]} << 16) | (uint32_t{b[1]} << 8) | b[0];
   }
 
-  Status Corrupt(const std::string& problem) const {
-    return Status::DataLoss(what_ + ": not a valid MAT file (" + problem + ")");
-  }
+  Status Corrupt(const std::string& problem) const { return NotValidMat(what_, problem); }
 
   // One data element from the front of `data`: its type, byte count and payload (the small
   // format packs up to 4 bytes into the tag). Advances past the 8-byte padding.
@@ -148,8 +152,9 @@ class Walker {
       if (Status s = Tag(&data, &type, &size, &names); !s.ok()) return s;
       fields = length == 0 ? 0 : names.size() / length;
     }
-    // Each element of each field is a miMATRIX element of at least its 8-byte tag.
-    if (elements * fields > own_bytes / 8) {
+    // Each element of each field is a miMATRIX element of at least its 8-byte tag. (Divided, not
+    // multiplied: a saturated element count times millions of field names would wrap around.)
+    if (fields != 0 && elements > own_bytes / 8 / fields) {
       return Corrupt("a struct or cell array claims " + std::to_string(elements) + " x " +
                      std::to_string(fields) + " values in " + std::to_string(own_bytes) + " bytes");
     }
@@ -174,14 +179,18 @@ Status CheckMat5Bounds(std::string_view bytes, const std::string& what) {
                             " bytes is too large for an annotation file");
   }
   // Header: 116 bytes of text, 8 of subsystem offset, version (2 bytes), endian indicator "IM"
-  // (little-endian file) or "MI". Anything else (v4, v7.3/HDF5) is left to libmatio.
-  if (bytes.size() < 128) return Status::Ok();
+  // (little-endian file) or "MI". Version 0x0100 is Level 5 (MATLAB's -v6 and -v7); 0x0200 is a
+  // -v7.3 file, HDF5 behind the same header, which libmatio hands to libhdf5 and is left to it.
+  // Anything else is refused rather than passed on: libmatio would read it as MAT v4 (see
+  // mat5_bounds.h), and a v4 file cannot hold the annotations struct anyway.
+  if (bytes.size() < 128) return NotValidMat(what, "shorter than the 128-byte Level-5 header");
   const std::string_view endian = bytes.substr(126, 2);
-  if (endian != "IM" && endian != "MI") return Status::Ok();
+  if (endian != "IM" && endian != "MI") return NotValidMat(what, "no Level-5 header");
   const bool swap = endian == "MI";
   const auto* v = reinterpret_cast<const unsigned char*>(bytes.data() + 124);
   const unsigned version = swap ? (v[0] << 8) | v[1] : (v[1] << 8) | v[0];
-  if (version != 0x0100) return Status::Ok();
+  if (version == kVersion73) return Status::Ok();
+  if (version != kVersion5) return NotValidMat(what, "unknown version " + std::to_string(version));
   return Walker(swap, what).Elements(bytes.substr(128), true);
 }
 

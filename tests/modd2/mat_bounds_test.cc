@@ -1,5 +1,6 @@
 // Regression tests for inputs found by fuzz_modd2_mat (README, "Fuzzing"): MAT files whose arrays
-// claim far more elements than they hold, which libmatio would allocate before failing.
+// claim far more elements than they hold, and files without a Level-5 header, whose MAT v4 header
+// libmatio trusts; libmatio would allocate what they claim before failing.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -27,21 +28,48 @@ void PutU32(std::string* bytes, size_t at, uint32_t value) {
   for (int i = 0; i < 4; ++i) (*bytes)[at + i] = static_cast<char>((value >> (8 * i)) & 0xFF);
 }
 
-// A 378-byte compressed annotation (a mutated seed) whose variable inflates to far less than its
-// headers claim: libmatio created 9 million struct fields for it, over 2 GB (the fuzzer's
-// out-of-memory limit), before this check existed.
-TEST(Mat5BoundsTest, FuzzerInputClaimingMillionsOfStructFieldsIsRefusedQuickly) {
-  const fs::path input = fs::path(testing_env::SourceDir()) /
-                         "tests/fuzz/corpus/fuzz_modd2_mat/"
-                         "oom-d56342ba33a6f5a014e325e68c304e71d1ab2b89";
-  ASSERT_TRUE(fs::exists(input)) << input;
+// Reads `path` as an annotation and expects a quick DataLoss naming the invalid MAT file.
+void ExpectRefusedQuickly(const fs::path& path) {
+  ASSERT_TRUE(fs::exists(path)) << path;
   const auto start = std::chrono::steady_clock::now();
-  const Result<Modd2Annotation> annotation = ReadModd2Annotation(input.string());
+  const Result<Modd2Annotation> annotation = ReadModd2Annotation(path.string());
   ASSERT_FALSE(annotation.ok());
   EXPECT_EQ(annotation.status().code(), StatusCode::kDataLoss);
   EXPECT_NE(annotation.status().message().find("not a valid MAT file"), std::string::npos)
       << annotation.status().message();
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+}
+
+fs::path CorpusInput(const std::string& name) {
+  return fs::path(testing_env::SourceDir()) / "tests/fuzz/corpus/fuzz_modd2_mat" / name;
+}
+
+// A 378-byte compressed annotation (a mutated seed) whose variable inflates to far less than its
+// headers claim: libmatio created 9 million struct fields for it, over 2 GB (the fuzzer's
+// out-of-memory limit), before this check existed.
+TEST(Mat5BoundsTest, FuzzerInputClaimingMillionsOfStructFieldsIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("oom-d56342ba33a6f5a014e325e68c304e71d1ab2b89"));
+}
+
+// A 147-byte mutated seed whose endian indicator is gone: libmatio read it as MAT v4, took bytes
+// 16-19 of the header text as a 1.1 GB variable name and allocated and cleared that much in
+// Mat_Open (over 25 s under the fuzzer's sanitizers, 4 s without).
+TEST(Mat5BoundsTest, FuzzerInputReadAsMatV4WithAHugeNameIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("timeout-e44665c1cd7483b522a68308cd294bc7837c40ea"));
+}
+
+// The same cause, constructed: a MAT v4 header (type, rows, columns, complex flag, name length)
+// claiming a 2 GB name, followed by a few bytes.
+TEST(Mat5BoundsTest, MatV4HeaderClaimingAHugeNameIsRefused) {
+  std::string bytes(40, 'x');
+  for (size_t at = 0; at < 16; ++at) bytes[at] = 0;
+  PutU32(&bytes, 4, 1);            // 1 row
+  PutU32(&bytes, 8, 1);            // 1 column
+  PutU32(&bytes, 16, 0x7FFFFFF0);  // name length
+  const fs::path path = fs::path(::testing::TempDir()) / "mat_v4_huge_name.mat";
+  std::ofstream(path, std::ios::binary) << bytes;
+  ExpectRefusedQuickly(path);
+  fs::remove(path);
 }
 
 class Mat5BoundsFileTest : public ::testing::Test {
@@ -86,9 +114,65 @@ TEST_F(Mat5BoundsFileTest, NumericFieldClaimingAHugeSizeIsRefused) {
   EXPECT_EQ(status.code(), StatusCode::kDataLoss) << status.message();
 }
 
-TEST(Mat5BoundsTest, NotLevel5IsLeftToMatio) {
-  EXPECT_TRUE(CheckMat5Bounds("", "x.mat").ok());
-  EXPECT_TRUE(CheckMat5Bounds(std::string(200, 'x'), "x.mat").ok());
+// A struct whose element count saturates (2^20 x 2^20) and whose field names are 16 Mi one-byte
+// names: the product of the two is 2^64, which must not wrap around to zero.
+TEST(Mat5BoundsTest, StructWhoseElementsTimesFieldsOverflowsIsRefused) {
+  constexpr uint32_t kFields = 1u << 24;
+  std::string matrix;
+  const auto element = [&matrix](uint32_t type, const std::string& payload) {
+    std::string tag(8, '\0');
+    PutU32(&tag, 0, type);
+    PutU32(&tag, 4, static_cast<uint32_t>(payload.size()));
+    matrix += tag + payload + std::string((8 - payload.size() % 8) % 8, '\0');
+  };
+  std::string flags(8, '\0'), dims(8, '\0'), name_length(4, '\0');
+  PutU32(&flags, 0, 2);  // mxSTRUCT_CLASS
+  PutU32(&dims, 0, 1u << 20);
+  PutU32(&dims, 4, 1u << 20);
+  PutU32(&name_length, 0, 1);
+  element(6, flags);  // miUINT32
+  element(5, dims);   // miINT32
+  element(1, "s");    // miINT8
+  element(5, name_length);
+  element(1, std::string(kFields, 'f'));
+  std::string bytes(128, ' ');
+  PutU32(&bytes, 124, 0x4D490100);  // version 0x0100, "IM"
+  std::string tag(8, '\0');
+  PutU32(&tag, 0, 14);  // miMATRIX
+  PutU32(&tag, 4, static_cast<uint32_t>(matrix.size()));
+  bytes += tag + matrix;
+  const Status status = CheckMat5Bounds(bytes, "x.mat");
+  EXPECT_EQ(status.code(), StatusCode::kDataLoss) << status.message();
+}
+
+// Only Level-5 files (and v7.3 ones, HDF5 behind a Level-5 style header) reach libmatio: anything
+// else it would read as MAT v4.
+TEST(Mat5BoundsTest, FilesWithoutALevel5HeaderAreRefused) {
+  EXPECT_EQ(CheckMat5Bounds("", "x.mat").code(), StatusCode::kDataLoss);
+  EXPECT_EQ(CheckMat5Bounds(std::string(200, 'x'), "x.mat").code(), StatusCode::kDataLoss);
+  std::string header(128, ' ');
+  PutU32(&header, 124, 0x4D490300);  // "IM", version 0x0300
+  const Status status = CheckMat5Bounds(header, "x.mat");
+  EXPECT_EQ(status.code(), StatusCode::kDataLoss);
+  EXPECT_NE(status.message().find("x.mat"), std::string::npos) << status.message();
+  PutU32(&header, 124, 0x4D490200);  // "IM", version 0x0200 (v7.3)
+  EXPECT_TRUE(CheckMat5Bounds(header, "x.mat").ok());
+  PutU32(&header, 124, 0x4D490100);  // "IM", version 0x0100, no variables
+  EXPECT_TRUE(CheckMat5Bounds(header, "x.mat").ok());
+}
+
+// A genuine MAT v4 file (written by libmatio) cannot hold the annotations struct: refused before
+// libmatio opens it, with the reason.
+TEST(Mat5BoundsTest, MatV4FileIsRefused) {
+  const std::string path = (fs::path(::testing::TempDir()) / "mat_v4.mat").string();
+  ASSERT_TRUE(modd2_test::WriteNumericMat(path, modd2_test::Matrix("annotations", {{1, 2}}),
+                                          MAT_COMPRESSION_NONE, MAT_FT_MAT4));
+  const Result<Modd2Annotation> annotation = ReadModd2Annotation(path);
+  ASSERT_FALSE(annotation.ok());
+  EXPECT_EQ(annotation.status().code(), StatusCode::kDataLoss);
+  EXPECT_NE(annotation.status().message().find("Level-5"), std::string::npos)
+      << annotation.status().message();
+  fs::remove(path);
 }
 
 }  // namespace
