@@ -20,6 +20,7 @@ constexpr uint32_t kClassStruct = 2;
 constexpr uint32_t kClassObject = 3;
 constexpr uint32_t kClassSparse = 5;
 constexpr uint32_t kLastNumericClass = 15;  // mxUINT64_CLASS
+constexpr uint32_t kLastClass = 17;         // mxOPAQUE_CLASS
 constexpr int kMaxDepth = 32;
 constexpr unsigned kVersion5 = 0x0100;
 constexpr unsigned kVersion73 = 0x0200;
@@ -116,9 +117,15 @@ class Walker {
     if (Status s = Tag(&data, &type, &size, &flags); !s.ok()) return s;
     if (flags.size() < 4) return Corrupt("array flags too short");
     const uint32_t array_class = U32(flags.data()) & 0xFF;
-    // Classes past the numeric ones (opaque, function handles) have no dimensions subelement.
-    if (array_class > kLastNumericClass) return Status::Ok();
+    if (array_class < kClassCell || array_class > kLastClass) {
+      return Corrupt("unknown array class " + std::to_string(array_class));
+    }
+    // libmatio reads the second subelement as the dimensions whatever the class and, when it is
+    // tagged int32, allocates 8 bytes per value its tag claims (a 424-byte file claiming a billion
+    // dimensions made it allocate 8 GB). Tag checks that size against the container for every
+    // class; function handles and opaque objects lay out the rest differently and stop here.
     if (Status s = Tag(&data, &type, &size, &dims); !s.ok()) return s;
+    if (array_class > kLastNumericClass) return Status::Ok();
     if (type != kMiInt32 || dims.size() < 8 || dims.size() % 4 != 0) {
       return Corrupt("array dimensions are not two or more int32 values");
     }

@@ -58,6 +58,13 @@ TEST(Mat5BoundsTest, FuzzerInputReadAsMatV4WithAHugeNameIsRefusedQuickly) {
   ExpectRefusedQuickly(CorpusInput("timeout-e44665c1cd7483b522a68308cd294bc7837c40ea"));
 }
 
+// A 424-byte mutated seed: 'annotations' has an unknown array class (33), which the walker used to
+// skip, and a dimensions tag claiming 4 GB; libmatio allocated 8 bytes per claimed dimension, 8 GB
+// (over 10 s in the sanitizers' allocator) before failing.
+TEST(Mat5BoundsTest, FuzzerInputWithUnknownClassAndHugeDimensionsIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("timeout-3885b1deca9263bffaec7ca79eb5077e80ec188c"));
+}
+
 // The same cause, constructed: a MAT v4 header (type, rows, columns, complex flag, name length)
 // claiming a 2 GB name, followed by a few bytes.
 TEST(Mat5BoundsTest, MatV4HeaderClaimingAHugeNameIsRefused) {
@@ -104,6 +111,28 @@ TEST_F(Mat5BoundsFileTest, StructClaimingAHugeSizeIsRefused) {
   PutU32(&broken, DimsAfter(128), 100'000'000);  // 'annotations' as 100000000 x 1
   const Status status = CheckMat5Bounds(broken, "x.mat");
   EXPECT_EQ(status.code(), StatusCode::kDataLoss) << status.message();
+}
+
+// libmatio reads the dimensions tag of an array of any class, opaque objects included: its size is
+// checked for each of them, and classes libmatio does not know are refused.
+TEST_F(Mat5BoundsFileTest, DimensionsClaimingMoreThanTheFileAreRefusedForEveryClass) {
+  constexpr size_t kClassAt = 128 + 16;     // first value of the first array's flags
+  constexpr size_t kDimsSizeAt = 128 + 28;  // byte count in the first array's dimensions tag
+  ASSERT_EQ(bytes_.substr(128 + 24, 4), std::string("\x05\0\0\0", 4));
+  for (const uint8_t array_class : {1, 2, 6, 15, 16, 17}) {
+    std::string broken = bytes_;
+    broken[kClassAt] = static_cast<char>(array_class);
+    PutU32(&broken, kDimsSizeAt, 0xFFFD0008);
+    EXPECT_EQ(CheckMat5Bounds(broken, "x.mat").code(), StatusCode::kDataLoss)
+        << "class " << int{array_class};
+  }
+  for (const uint8_t array_class : {0, 18, 33, 255}) {
+    std::string broken = bytes_;
+    broken[kClassAt] = static_cast<char>(array_class);
+    const Status status = CheckMat5Bounds(broken, "x.mat");
+    EXPECT_EQ(status.code(), StatusCode::kDataLoss) << "class " << int{array_class};
+    EXPECT_NE(status.message().find("class"), std::string::npos) << status.message();
+  }
 }
 
 TEST_F(Mat5BoundsFileTest, NumericFieldClaimingAHugeSizeIsRefused) {
