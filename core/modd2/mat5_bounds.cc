@@ -19,8 +19,8 @@ constexpr uint32_t kClassCell = 1;
 constexpr uint32_t kClassStruct = 2;
 constexpr uint32_t kClassObject = 3;
 constexpr uint32_t kClassSparse = 5;
-constexpr uint32_t kLastNumericClass = 15;  // mxUINT64_CLASS
-constexpr uint32_t kLastClass = 17;         // mxOPAQUE_CLASS
+constexpr uint32_t kClassFunction = 16;
+constexpr uint32_t kClassOpaque = 17;
 constexpr int kMaxDepth = 32;
 constexpr unsigned kVersion5 = 0x0100;
 constexpr unsigned kVersion73 = 0x0200;
@@ -117,55 +117,80 @@ class Walker {
     if (Status s = Tag(&data, &type, &size, &flags); !s.ok()) return s;
     if (flags.size() < 4) return Corrupt("array flags too short");
     const uint32_t array_class = U32(flags.data()) & 0xFF;
-    if (array_class < kClassCell || array_class > kLastClass) {
+    if (array_class < kClassCell || array_class > kClassOpaque) {
       return Corrupt("unknown array class " + std::to_string(array_class));
     }
     // libmatio reads the second subelement as the dimensions whatever the class and, when it is
     // tagged int32, allocates 8 bytes per value its tag claims (a 424-byte file claiming a billion
     // dimensions made it allocate 8 GB). Tag checks that size against the container for every
-    // class; function handles and opaque objects lay out the rest differently and stop here.
+    // class. An opaque object lays out the rest differently; libmatio 1.5.23 allocates nothing by
+    // its dimensions (tried with a claim of 1.9e9 elements), so the walk stops there.
     if (Status s = Tag(&data, &type, &size, &dims); !s.ok()) return s;
-    if (array_class > kLastNumericClass) return Status::Ok();
+    if (array_class == kClassOpaque) return Status::Ok();
+    uint64_t elements = 0;
+    if (Status s = ElementCount(type, dims, &elements); !s.ok()) return s;
+    if (Status s = Tag(&data, &type, &size, &name); !s.ok()) return s;
+    switch (array_class) {
+      case kClassSparse:  // stored by its non-zeros, not by its dimensions
+        return Status::Ok();
+      case kClassCell:
+      case kClassFunction:  // libmatio reads a function handle array as a cell array
+        return Values(data, elements, 1, own_bytes, depth);
+      case kClassStruct:
+      case kClassObject:
+        return StructValues(data, array_class, elements, own_bytes, depth);
+      default:  // numeric or char: every element takes at least one stored byte
+        if (elements > own_bytes) {
+          return Corrupt("an array claims " + std::to_string(elements) + " elements in " +
+                         std::to_string(own_bytes) + " bytes");
+        }
+        return Status::Ok();
+    }
+  }
+
+  // The product of int32 dimensions (two or more), saturated at 2^40: far more than any array
+  // that fits in kMaxMatFileBytes, so a saturated count is refused all the same.
+  Status ElementCount(uint32_t type, std::string_view dims, uint64_t* elements) const {
     if (type != kMiInt32 || dims.size() < 8 || dims.size() % 4 != 0) {
       return Corrupt("array dimensions are not two or more int32 values");
     }
-    uint64_t elements = 1;
+    constexpr uint64_t kSaturated = uint64_t{1} << 40;
+    *elements = 1;
     for (size_t at = 0; at < dims.size(); at += 4) {
       const int32_t d = static_cast<int32_t>(U32(dims.data() + at));
       if (d < 0) return Corrupt("negative array dimension");
-      // Saturates instead of overflowing; any product this large is refused below anyway.
-      elements =
-          d == 0 ? 0 : (elements > (uint64_t{1} << 40) / d ? uint64_t{1} << 40 : elements * d);
+      *elements = d == 0 ? 0 : (*elements > kSaturated / d ? kSaturated : *elements * d);
     }
-    if (Status s = Tag(&data, &type, &size, &name); !s.ok()) return s;
-    if (array_class == kClassSparse) return Status::Ok();  // stored by non-zeros, not by dims
-    if (array_class != kClassStruct && array_class != kClassObject && array_class != kClassCell) {
-      // Numeric or char: every element takes at least one stored byte.
-      if (elements > own_bytes) {
-        return Corrupt("an array claims " + std::to_string(elements) + " elements in " +
-                       std::to_string(own_bytes) + " bytes");
-      }
-      return Status::Ok();
+    return Status::Ok();
+  }
+
+  // A struct's (or object's) field names, then its values.
+  Status StructValues(std::string_view data, uint32_t array_class, uint64_t elements,
+                      size_t own_bytes, int depth) {
+    uint32_t type = 0, size = 0;
+    std::string_view class_name, name_length, names;
+    if (array_class == kClassObject) {
+      if (Status s = Tag(&data, &type, &size, &class_name); !s.ok()) return s;
     }
-    uint64_t fields = 1;
-    if (array_class != kClassCell) {
-      std::string_view class_name, name_length, names;
-      if (array_class == kClassObject) {
-        if (Status s = Tag(&data, &type, &size, &class_name); !s.ok()) return s;
-      }
-      if (Status s = Tag(&data, &type, &size, &name_length); !s.ok()) return s;
-      if (name_length.size() < 4) return Corrupt("struct field name length missing");
-      const uint32_t length = U32(name_length.data());
-      if (Status s = Tag(&data, &type, &size, &names); !s.ok()) return s;
-      fields = length == 0 ? 0 : names.size() / length;
-    }
-    // Each element of each field is a miMATRIX element of at least its 8-byte tag. (Divided, not
-    // multiplied: a saturated element count times millions of field names would wrap around.)
+    if (Status s = Tag(&data, &type, &size, &name_length); !s.ok()) return s;
+    if (name_length.size() < 4) return Corrupt("struct field name length missing");
+    const uint32_t length = U32(name_length.data());
+    if (Status s = Tag(&data, &type, &size, &names); !s.ok()) return s;
+    const uint64_t fields = length == 0 ? 0 : names.size() / length;
+    return Values(data, elements, fields, own_bytes, depth);
+  }
+
+  // `elements` x `fields` values, each a miMATRIX element of at least its 8-byte tag (libmatio
+  // allocates one matvar_t per value before reading them). Divided, not multiplied: a saturated
+  // element count times millions of field names would wrap around.
+  Status Values(std::string_view data, uint64_t elements, uint64_t fields, size_t own_bytes,
+                int depth) {
     if (fields != 0 && elements > own_bytes / 8 / fields) {
       return Corrupt("a struct or cell array claims " + std::to_string(elements) + " x " +
                      std::to_string(fields) + " values in " + std::to_string(own_bytes) + " bytes");
     }
     for (uint64_t i = 0; i < elements * fields && !data.empty(); ++i) {
+      uint32_t type = 0, size = 0;
       std::string_view child;
       if (Status s = Tag(&data, &type, &size, &child); !s.ok()) return s;
       if (type != kMiMatrix) return Corrupt("a struct or cell value is not an array");

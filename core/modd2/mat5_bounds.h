@@ -6,8 +6,9 @@
 //    that Mat_Open allocates (and clears) before reading: 147 bytes claiming a 1.1 GB name took
 //    over 25 s per open under the fuzzer's sanitizers.
 // So this accepts only Level-5 files (and the header of a v7.3/HDF5 file), walks their matrix
-// headers (inflating compressed variables, up to a cap) and refuses any array that claims more
-// elements than its own bytes could hold.
+// headers as libmatio reads them (inflating compressed variables, up to a cap; the dimensions of
+// every class; function handles as cells) and refuses any array that claims more elements than
+// its own bytes could hold.
 #pragma once
 
 #include <string>

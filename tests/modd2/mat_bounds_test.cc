@@ -65,6 +65,13 @@ TEST(Mat5BoundsTest, FuzzerInputWithUnknownClassAndHugeDimensionsIsRefusedQuickl
   ExpectRefusedQuickly(CorpusInput("timeout-3885b1deca9263bffaec7ca79eb5077e80ec188c"));
 }
 
+// A 392-byte mutated seed: a function handle array (class 16) of 1 x 1.9 billion. libmatio reads
+// function handles as cell arrays and allocated a pointer per claimed element (15 GB; out of
+// memory under the fuzzer); the walker used to stop at classes past the numeric ones.
+TEST(Mat5BoundsTest, FuzzerInputWithAHugeFunctionHandleArrayIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("oom-4470bbbeaea222285e23e1cc994a3d7d31b5bd4c"));
+}
+
 // The same cause, constructed: a MAT v4 header (type, rows, columns, complex flag, name length)
 // claiming a 2 GB name, followed by a few bytes.
 TEST(Mat5BoundsTest, MatV4HeaderClaimingAHugeNameIsRefused) {
@@ -133,6 +140,14 @@ TEST_F(Mat5BoundsFileTest, DimensionsClaimingMoreThanTheFileAreRefusedForEveryCl
     EXPECT_EQ(status.code(), StatusCode::kDataLoss) << "class " << int{array_class};
     EXPECT_NE(status.message().find("class"), std::string::npos) << status.message();
   }
+}
+
+TEST_F(Mat5BoundsFileTest, FunctionHandleArrayClaimingAHugeSizeIsRefused) {
+  std::string broken = bytes_;
+  broken[128 + 16] = 16;                         // 'annotations' as a function handle array
+  PutU32(&broken, DimsAfter(128), 100'000'000);  // of 100000000 x 1
+  const Status status = CheckMat5Bounds(broken, "x.mat");
+  EXPECT_EQ(status.code(), StatusCode::kDataLoss) << status.message();
 }
 
 TEST_F(Mat5BoundsFileTest, NumericFieldClaimingAHugeSizeIsRefused) {
