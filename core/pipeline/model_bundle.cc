@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/pipeline/json_integers.h"
+
 namespace tod {
 namespace fs = std::filesystem;
 namespace {
@@ -153,7 +155,10 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
   }
   ModelBundle bundle;
   try {
-    const int format = manifest.at("format_version").get<int>();
+    const Result<int> version = JsonToInt(manifest.at("format_version"), "format_version");
+    if (!version.ok())
+      return Status::InvalidArgument(manifest_path + ": " + version.status().message());
+    const int format = *version;
     if (format != kBundleFormatVersion)
       return Status::FailedPrecondition(manifest_path + ": format_version " +
                                         std::to_string(format) + ", this build reads " +
