@@ -19,8 +19,15 @@ constexpr uint32_t kClassCell = 1;
 constexpr uint32_t kClassStruct = 2;
 constexpr uint32_t kClassObject = 3;
 constexpr uint32_t kClassSparse = 5;
-constexpr uint32_t kLastNumericClass = 15;  // mxUINT64_CLASS
+constexpr uint32_t kClassFunction = 16;
+constexpr uint32_t kClassOpaque = 17;
 constexpr int kMaxDepth = 32;
+constexpr unsigned kVersion5 = 0x0100;
+constexpr unsigned kVersion73 = 0x0200;
+
+Status NotValidMat(const std::string& what, const std::string& problem) {
+  return Status::DataLoss(what + ": not a valid MAT file (" + problem + ")");
+}
 
 class Walker {
  public:
@@ -51,9 +58,7 @@ class Walker {
                  : (uint32_t{b[3]} << 24) | (uint32_t{b[2]} << 16) | (uint32_t{b[1]} << 8) | b[0];
   }
 
-  Status Corrupt(const std::string& problem) const {
-    return Status::DataLoss(what_ + ": not a valid MAT file (" + problem + ")");
-  }
+  Status Corrupt(const std::string& problem) const { return NotValidMat(what_, problem); }
 
   // One data element from the front of `data`: its type, byte count and payload (the small
   // format packs up to 4 bytes into the tag). Advances past the 8-byte padding.
@@ -112,48 +117,80 @@ class Walker {
     if (Status s = Tag(&data, &type, &size, &flags); !s.ok()) return s;
     if (flags.size() < 4) return Corrupt("array flags too short");
     const uint32_t array_class = U32(flags.data()) & 0xFF;
-    // Classes past the numeric ones (opaque, function handles) have no dimensions subelement.
-    if (array_class > kLastNumericClass) return Status::Ok();
+    if (array_class < kClassCell || array_class > kClassOpaque) {
+      return Corrupt("unknown array class " + std::to_string(array_class));
+    }
+    // libmatio reads the second subelement as the dimensions whatever the class and, when it is
+    // tagged int32, allocates 8 bytes per value its tag claims (a 424-byte file claiming a billion
+    // dimensions made it allocate 8 GB). Tag checks that size against the container for every
+    // class. An opaque object lays out the rest differently; libmatio 1.5.23 allocates nothing by
+    // its dimensions (tried with a claim of 1.9e9 elements), so the walk stops there.
     if (Status s = Tag(&data, &type, &size, &dims); !s.ok()) return s;
+    if (array_class == kClassOpaque) return Status::Ok();
+    uint64_t elements = 0;
+    if (Status s = ElementCount(type, dims, &elements); !s.ok()) return s;
+    if (Status s = Tag(&data, &type, &size, &name); !s.ok()) return s;
+    switch (array_class) {
+      case kClassSparse:  // stored by its non-zeros, not by its dimensions
+        return Status::Ok();
+      case kClassCell:
+      case kClassFunction:  // libmatio reads a function handle array as a cell array
+        return Values(data, elements, 1, own_bytes, depth);
+      case kClassStruct:
+      case kClassObject:
+        return StructValues(data, array_class, elements, own_bytes, depth);
+      default:  // numeric or char: every element takes at least one stored byte
+        if (elements > own_bytes) {
+          return Corrupt("an array claims " + std::to_string(elements) + " elements in " +
+                         std::to_string(own_bytes) + " bytes");
+        }
+        return Status::Ok();
+    }
+  }
+
+  // The product of int32 dimensions (two or more), saturated at 2^40: far more than any array
+  // that fits in kMaxMatFileBytes, so a saturated count is refused all the same.
+  Status ElementCount(uint32_t type, std::string_view dims, uint64_t* elements) const {
     if (type != kMiInt32 || dims.size() < 8 || dims.size() % 4 != 0) {
       return Corrupt("array dimensions are not two or more int32 values");
     }
-    uint64_t elements = 1;
+    constexpr uint64_t kSaturated = uint64_t{1} << 40;
+    *elements = 1;
     for (size_t at = 0; at < dims.size(); at += 4) {
       const int32_t d = static_cast<int32_t>(U32(dims.data() + at));
       if (d < 0) return Corrupt("negative array dimension");
-      // Saturates instead of overflowing; any product this large is refused below anyway.
-      elements =
-          d == 0 ? 0 : (elements > (uint64_t{1} << 40) / d ? uint64_t{1} << 40 : elements * d);
+      *elements = d == 0 ? 0 : (*elements > kSaturated / d ? kSaturated : *elements * d);
     }
-    if (Status s = Tag(&data, &type, &size, &name); !s.ok()) return s;
-    if (array_class == kClassSparse) return Status::Ok();  // stored by non-zeros, not by dims
-    if (array_class != kClassStruct && array_class != kClassObject && array_class != kClassCell) {
-      // Numeric or char: every element takes at least one stored byte.
-      if (elements > own_bytes) {
-        return Corrupt("an array claims " + std::to_string(elements) + " elements in " +
-                       std::to_string(own_bytes) + " bytes");
-      }
-      return Status::Ok();
+    return Status::Ok();
+  }
+
+  // A struct's (or object's) field names, then its values.
+  Status StructValues(std::string_view data, uint32_t array_class, uint64_t elements,
+                      size_t own_bytes, int depth) {
+    uint32_t type = 0, size = 0;
+    std::string_view class_name, name_length, names;
+    if (array_class == kClassObject) {
+      if (Status s = Tag(&data, &type, &size, &class_name); !s.ok()) return s;
     }
-    uint64_t fields = 1;
-    if (array_class != kClassCell) {
-      std::string_view class_name, name_length, names;
-      if (array_class == kClassObject) {
-        if (Status s = Tag(&data, &type, &size, &class_name); !s.ok()) return s;
-      }
-      if (Status s = Tag(&data, &type, &size, &name_length); !s.ok()) return s;
-      if (name_length.size() < 4) return Corrupt("struct field name length missing");
-      const uint32_t length = U32(name_length.data());
-      if (Status s = Tag(&data, &type, &size, &names); !s.ok()) return s;
-      fields = length == 0 ? 0 : names.size() / length;
-    }
-    // Each element of each field is a miMATRIX element of at least its 8-byte tag.
-    if (elements * fields > own_bytes / 8) {
+    if (Status s = Tag(&data, &type, &size, &name_length); !s.ok()) return s;
+    if (name_length.size() < 4) return Corrupt("struct field name length missing");
+    const uint32_t length = U32(name_length.data());
+    if (Status s = Tag(&data, &type, &size, &names); !s.ok()) return s;
+    const uint64_t fields = length == 0 ? 0 : names.size() / length;
+    return Values(data, elements, fields, own_bytes, depth);
+  }
+
+  // `elements` x `fields` values, each a miMATRIX element of at least its 8-byte tag (libmatio
+  // allocates one matvar_t per value before reading them). Divided, not multiplied: a saturated
+  // element count times millions of field names would wrap around.
+  Status Values(std::string_view data, uint64_t elements, uint64_t fields, size_t own_bytes,
+                int depth) {
+    if (fields != 0 && elements > own_bytes / 8 / fields) {
       return Corrupt("a struct or cell array claims " + std::to_string(elements) + " x " +
                      std::to_string(fields) + " values in " + std::to_string(own_bytes) + " bytes");
     }
     for (uint64_t i = 0; i < elements * fields && !data.empty(); ++i) {
+      uint32_t type = 0, size = 0;
       std::string_view child;
       if (Status s = Tag(&data, &type, &size, &child); !s.ok()) return s;
       if (type != kMiMatrix) return Corrupt("a struct or cell value is not an array");
@@ -174,14 +211,18 @@ Status CheckMat5Bounds(std::string_view bytes, const std::string& what) {
                             " bytes is too large for an annotation file");
   }
   // Header: 116 bytes of text, 8 of subsystem offset, version (2 bytes), endian indicator "IM"
-  // (little-endian file) or "MI". Anything else (v4, v7.3/HDF5) is left to libmatio.
-  if (bytes.size() < 128) return Status::Ok();
+  // (little-endian file) or "MI". Version 0x0100 is Level 5 (MATLAB's -v6 and -v7); 0x0200 is a
+  // -v7.3 file, HDF5 behind the same header, which libmatio hands to libhdf5 and is left to it.
+  // Anything else is refused rather than passed on: libmatio would read it as MAT v4 (see
+  // mat5_bounds.h), and a v4 file cannot hold the annotations struct anyway.
+  if (bytes.size() < 128) return NotValidMat(what, "shorter than the 128-byte Level-5 header");
   const std::string_view endian = bytes.substr(126, 2);
-  if (endian != "IM" && endian != "MI") return Status::Ok();
+  if (endian != "IM" && endian != "MI") return NotValidMat(what, "no Level-5 header");
   const bool swap = endian == "MI";
   const auto* v = reinterpret_cast<const unsigned char*>(bytes.data() + 124);
   const unsigned version = swap ? (v[0] << 8) | v[1] : (v[1] << 8) | v[0];
-  if (version != 0x0100) return Status::Ok();
+  if (version == kVersion73) return Status::Ok();
+  if (version != kVersion5) return NotValidMat(what, "unknown version " + std::to_string(version));
   return Walker(swap, what).Elements(bytes.substr(128), true);
 }
 

@@ -11,6 +11,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/binary_io.h"
 #include "core/base/checksum.h"
+#include "core/pipeline/json_integers.h"
 
 namespace tod {
 namespace fs = std::filesystem;
@@ -140,7 +141,10 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
   }
   ModelBundle bundle;
   try {
-    const int format = manifest.at("format_version").get<int>();
+    const Result<int> version = JsonToInt(manifest.at("format_version"), "format_version");
+    if (!version.ok())
+      return Status::InvalidArgument(manifest_path + ": " + version.status().message());
+    const int format = *version;
     if (format != kBundleFormatVersion)
       return Status::FailedPrecondition(manifest_path + ": format_version " +
                                         std::to_string(format) + ", this build reads " +

@@ -6,6 +6,8 @@
 #include <numeric>
 #include <random>
 
+#include "core/pipeline/json_integers.h"
+
 namespace tod {
 namespace {
 
@@ -137,10 +139,16 @@ nlohmann::json MultilayerRegions::ToJson() const {
 Result<MultilayerRegions> MultilayerRegions::FromJson(const nlohmann::json& j) {
   try {
     MultilayerRegions out;
-    out.image_width = j.at("image_width").get<int>();
-    out.image_height = j.at("image_height").get<int>();
+    // Integers checked before they are converted (json_integers.h).
+    Result<int> width = JsonToInt(j.at("image_width"), "regions: image_width");
+    if (!width.ok()) return width.status();
+    Result<int> height = JsonToInt(j.at("image_height"), "regions: image_height");
+    if (!height.ok()) return height.status();
+    out.image_width = *width;
+    out.image_height = *height;
     for (const auto& r : j.at("layers")) {
-      if (!r.is_array() || r.size() != 4) return Status::InvalidArgument("region is not [x,y,w,h]");
+      if (!r.is_array() || r.size() != 4 || !std::all_of(r.begin(), r.end(), IsJsonInt))
+        return Status::InvalidArgument("region is not [x,y,w,h] of ints");
       out.layers.push_back({r[0].get<int>(), r[1].get<int>(), r[2].get<int>(), r[3].get<int>()});
     }
     if (out.image_width <= 0 || out.image_height <= 0 || out.layers.empty())

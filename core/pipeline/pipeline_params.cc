@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "core/pipeline/json_integers.h"
+
 namespace tod {
 
 // Field lists for nlohmann's (de)serialisers: missing keys keep the paper's defaults, wrong types
@@ -39,6 +41,8 @@ void CorrectSampledPrior(cv::Mat1f& probability, double odds_scale) {
 }
 
 Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
+  // The readers above cast any number to an int field (json_integers.h): check those first.
+  if (Status s = CheckJsonIntegers(j, ToJson(PipelineParams{}), "parameters: "); !s.ok()) return s;
   PipelineParams p;
   try {
     p = j.get<PipelineParams>();

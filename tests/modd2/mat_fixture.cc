@@ -64,8 +64,8 @@ bool WriteStructMat(const std::string& path, const std::string& variable,
 }
 
 bool WriteNumericMat(const std::string& path, const MatMatrix& variable,
-                     matio_compression compression) {
-  std::unique_ptr<mat_t, MatFileCloser> mat(Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5));
+                     matio_compression compression, mat_ft version) {
+  std::unique_ptr<mat_t, MatFileCloser> mat(Mat_CreateVer(path.c_str(), nullptr, version));
   if (!mat) return false;
   MatVarPtr var = CreateVariable(variable, variable.name.c_str());
   return var && Mat_VarWrite(mat.get(), var.get(), compression) == 0;

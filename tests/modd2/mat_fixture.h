@@ -28,9 +28,10 @@ bool WriteStructMat(const std::string& path, const std::string& variable,
                     const std::vector<MatMatrix>& fields,
                     matio_compression compression = MAT_COMPRESSION_ZLIB, std::size_t elements = 1);
 
-// Writes one numeric variable (e.g. a non-struct 'annotations').
+// Writes one numeric variable (e.g. a non-struct 'annotations'), to a Level-5 file by default.
 bool WriteNumericMat(const std::string& path, const MatMatrix& variable,
-                     matio_compression compression = MAT_COMPRESSION_NONE);
+                     matio_compression compression = MAT_COMPRESSION_NONE,
+                     mat_ft version = MAT_FT_MAT5);
 
 // The usual annotation file: struct 'annotations' with sea_edge (Nx2) and obstacles (Mx4).
 bool WriteAnnotation(const std::string& path, const std::vector<std::vector<double>>& sea_edge,

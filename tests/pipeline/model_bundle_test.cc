@@ -141,6 +141,12 @@ TEST_F(ModelBundleTest, WrongFormatVersionAndBrokenManifestAreRefused) {
   auto loaded = LoadModelBundle(Path());
   ASSERT_FALSE(loaded.ok());
   EXPECT_NE(loaded.status().message().find("format_version 99"), std::string::npos);
+  j["format_version"] = 1e30;  // once converted to int unchecked: undefined behaviour
+  std::ofstream(manifest) << j.dump();
+  loaded = LoadModelBundle(Path());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(loaded.status().message().find("format_version"), std::string::npos);
   std::ofstream(manifest) << "{ not json";
   loaded = LoadModelBundle(Path());
   ASSERT_FALSE(loaded.ok());
