@@ -16,14 +16,8 @@ namespace {
 const std::vector<std::string> kBoundaries = {"edges",     "superpixels", "occlusion",
                                               "proposals", "features",    "regression"};
 
-class DetectCancellationTest : public ::testing::Test {
+class DetectCancellationTest : public TinyDetectorTest {
  protected:
-  static void SetUpTestSuite() { detector_ = new ObstacleDetector(TinyBundle(), "tiny"); }
-  static void TearDownTestSuite() {
-    delete detector_;
-    detector_ = nullptr;
-  }
-  static inline const ObstacleDetector* detector_ = nullptr;
   const cv::Mat3b frame_ = RoadFrame(256, 128);
 };
 

@@ -46,14 +46,8 @@ TEST(FrameBudgetTest, ShareOfRemainingSplitsTheTimeLeftByWeight) {
   EXPECT_EQ(ShareOfRemaining(stage_end, 4, 4), stage_end);  // the last piece gets all the rest
 }
 
-class DetectBudgetTest : public ::testing::Test {
+class DetectBudgetTest : public TinyDetectorTest {
  protected:
-  static void SetUpTestSuite() { detector_ = new ObstacleDetector(TinyBundle(), "tiny"); }
-  static void TearDownTestSuite() {
-    delete detector_;
-    detector_ = nullptr;
-  }
-  static inline const ObstacleDetector* detector_ = nullptr;
   const cv::Mat3b frame_ = RoadFrame(512, 256);
 };
 

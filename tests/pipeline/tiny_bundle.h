@@ -2,6 +2,9 @@
 // run but not to be accurate.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <memory>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <vector>
@@ -56,5 +59,15 @@ inline cv::Mat3b RoadFrame(int width, int height) {
   block(0.66, 0.80, 0.06, 0.10, cv::Scalar(230, 230, 230));  // near
   return frame;
 }
+
+// A suite whose tests share one ObstacleDetector on TinyBundle() (training its forests once).
+class TinyDetectorTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    detector_ = std::make_unique<const ObstacleDetector>(TinyBundle(), "tiny");
+  }
+  static void TearDownTestSuite() { detector_.reset(); }
+  static inline std::unique_ptr<const ObstacleDetector> detector_;
+};
 
 }  // namespace tod
