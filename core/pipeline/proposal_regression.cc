@@ -32,7 +32,6 @@ void SplitRange(std::size_t begin, std::size_t end, int threads, Body body) {
     if (!s.ok()) throw std::runtime_error(s.ToString());
 }
 
-
 }  // namespace
 
 RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& image,
@@ -56,8 +55,8 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
     feature_time += Clock::now() - chunk_start;
     SplitRange(done, end, limits.threads, [&](std::size_t b, std::size_t e) {
       // A row range is a view: the batched walk reads the rows in place.
-      const std::vector<float> scores = bundle.ordr.PredictBatch(
-          features.rowRange(static_cast<int>(b), static_cast<int>(e)));
+      const std::vector<float> scores =
+          bundle.ordr.PredictBatch(features.rowRange(static_cast<int>(b), static_cast<int>(e)));
       std::copy(scores.begin(), scores.end(), out.ordr.begin() + static_cast<long>(b));
     });
     done = end;
