@@ -45,6 +45,11 @@ class Walker {
         if (Status s = Inflate(payload, &inflated); !s.ok()) return s;
         if (Status s = Elements(inflated, false); !s.ok()) return s;
       } else if (type == kMiMatrix) {
+        // A variable whose tag claims no bytes: libmatio reads its header from the bytes that
+        // follow all the same (a fuzzed file made it allocate a 1 x 687 M struct this way), while
+        // the walk would take those bytes for further elements. An empty matrix is a value inside
+        // a cell or struct, never a variable of its own.
+        if (payload.empty()) return Corrupt("a variable of 0 bytes");
         if (Status s = Matrix(payload, 0); !s.ok()) return s;
       }
     }

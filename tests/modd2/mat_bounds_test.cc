@@ -72,6 +72,14 @@ TEST(Mat5BoundsTest, FuzzerInputWithAHugeFunctionHandleArrayIsRefusedQuickly) {
   ExpectRefusedQuickly(CorpusInput("oom-4470bbbeaea222285e23e1cc994a3d7d31b5bd4c"));
 }
 
+// A 392-byte mutated seed found by CI's 5 s fuzz_smoke: the 'annotations' variable's tag claims 0
+// bytes, and libmatio read the struct header that follows anyway (1 x 687 million elements, two
+// fields) and allocated for it (out of memory under the fuzzer); the walk took those bytes for
+// further elements.
+TEST(Mat5BoundsTest, FuzzerInputWithAZeroByteVariableIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("oom-851a22babb87dacc1e4f91f49d8edd8f74101167"));
+}
+
 // The same cause, constructed: a MAT v4 header (type, rows, columns, complex flag, name length)
 // claiming a 2 GB name, followed by a few bytes.
 TEST(Mat5BoundsTest, MatV4HeaderClaimingAHugeNameIsRefused) {
