@@ -20,10 +20,11 @@ namespace {
 struct DetectArgs {
   std::vector<std::string> inputs;
   std::string out_dir;
-  int max_proposals = -1;   // -1: server default
-  float threshold = -1.f;   // <0: server default
-  std::string map = "png";  // png | none
-  int timeout_ms = 0;       // 0: no deadline
+  int max_proposals = -1;               // -1: server default
+  float threshold = -1.f;               // <0: server default
+  std::string map = "png";              // png | none
+  std::string map_kind = "normalized";  // normalized | calibrated
+  int timeout_ms = 0;                   // 0: no deadline
 };
 
 tod::v1::DetectRequest MakeRequest(const DetectArgs& args, const std::string& path,
@@ -35,6 +36,8 @@ tod::v1::DetectRequest MakeRequest(const DetectArgs& args, const std::string& pa
   if (args.threshold >= 0) request.mutable_options()->set_obstacle_threshold(args.threshold);
   request.mutable_options()->set_map_format(args.map == "none" ? tod::v1::MAP_FORMAT_NONE
                                                                : tod::v1::MAP_FORMAT_PNG);
+  request.mutable_options()->set_map_kind(
+      args.map_kind == "calibrated" ? tod::v1::MAP_KIND_CALIBRATED : tod::v1::MAP_KIND_NORMALIZED);
   return request;
 }
 
@@ -181,6 +184,10 @@ void AddDetectOptions(CLI::App* command, std::string* addr, DetectArgs* args) {
   command->add_option("--max-proposals", args->max_proposals, "Proposals returned");
   command->add_option("--threshold", args->threshold, "Obstacle threshold on P");
   command->add_option("--map", args->map, "png | none")->check(CLI::IsMember({"png", "none"}));
+  command
+      ->add_option("--map-kind", args->map_kind,
+                   "normalized (the paper's map, peak 1 on every frame) | calibrated")
+      ->check(CLI::IsMember({"normalized", "calibrated"}));
   command->add_option("--timeout-ms", args->timeout_ms, "gRPC deadline per request (0: none)");
 }
 

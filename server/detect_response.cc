@@ -24,6 +24,8 @@ RequestOptions OptionsFromProto(const tod::v1::DetectOptions& options) {
     out.detect.min_obstacle_score = options.min_obstacle_score();
   }
   if (options.has_budget_ms()) out.detect.budget_ms = options.budget_ms();
+  out.detect.map_kind = options.map_kind() == tod::v1::MAP_KIND_CALIBRATED ? MapKind::kCalibrated
+                                                                           : MapKind::kNormalized;
   out.encode_map_png = options.map_format() != tod::v1::MAP_FORMAT_NONE;
   out.detect.want_probability_map = out.encode_map_png;
   return out;
@@ -57,6 +59,8 @@ void FillDetectResponse(const InferenceResult& result, const std::string& frame_
     map->set_width(detection.probability.cols);
     map->set_height(detection.probability.rows);
     map->set_png(result.map_png);
+    map->set_kind(detection.map_kind == MapKind::kCalibrated ? tod::v1::MAP_KIND_CALIBRATED
+                                                             : tod::v1::MAP_KIND_NORMALIZED);
   }
   for (const auto& [stage, ms] : result.timings) {
     tod::v1::StageTiming* timing = response->add_timings();

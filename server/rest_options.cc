@@ -75,6 +75,14 @@ Status ParseDetectQuery(const QueryParams& query, InferenceRequest* inference,
     }
   }
 
+  if (const auto kind = query.find("map_kind"); kind != query.end()) {
+    const std::optional<MapKind> parsed = ParseMapKind(kind->second);
+    if (!parsed)
+      return Status::InvalidArgument("query parameter map_kind='" + kind->second +
+                                     "': expected normalized or calibrated");
+    inference->options.map_kind = *parsed;
+  }
+
   const Result<std::optional<long long>> timeout_ms =
       IntegerParam(query, "timeout_ms", 0, kMaxRestTimeoutMs);
   if (!timeout_ms.ok()) return timeout_ms.status();

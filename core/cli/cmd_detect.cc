@@ -37,6 +37,12 @@ Runner AddDetectCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--max-proposals", args->options.max_proposals, "proposals listed in the JSON")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option_function<std::string>(
+         "--map-kind",
+         [args](const std::string& name) { args->options.map_kind = *ParseMapKind(name); },
+         "probability map written and thresholded: normalized (the paper's, default) or "
+         "calibrated")
+      ->check(CLI::IsMember({"normalized", "calibrated"}));
   AddFrameRequestOptions(cmd, &args->options);
   cmd->add_flag(
       "--stages", args->stages,

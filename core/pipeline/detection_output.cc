@@ -43,6 +43,7 @@ nlohmann::json DetectionToJson(const Detection& d, const std::string& image_name
   }
   timing["total"] = total;
   j["timing_ms"] = timing;
+  j["map_kind"] = MapKindName(d.map_kind);
   j["degraded"] = d.degraded();
   j["degraded_stages"] = d.degraded_stages;
   return j;

@@ -6,7 +6,9 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/base/stage_timer.h"
@@ -15,6 +17,19 @@
 
 namespace tod {
 
+// Which obstacle-occupied probability map a detection returns (and thresholds for obstacles).
+enum class MapKind {
+  // The paper's map (§7): the top half of the boxes summed, divided by the frame's maximum. Its
+  // peak is 1 on every frame; the paper's metrics are defined on it.
+  kNormalized,
+  // Per pixel, the calibrated score of the strongest fused box over it (probability_map.h):
+  // comparable across frames, so a threshold means the same on an empty road and a busy one.
+  kCalibrated,
+};
+// "normalized" / "calibrated", the name the REST query, the CLI and the JSON use.
+const char* MapKindName(MapKind kind);
+std::optional<MapKind> ParseMapKind(std::string_view name);
+
 struct DetectOptions {
   int max_proposals = 100;          // proposals returned (the map always uses all of them)
   float obstacle_threshold = 0.5f;  // obstacle mask = P > threshold
@@ -22,6 +37,7 @@ struct DetectOptions {
   // an empty road reports no obstacle.
   float min_obstacle_score = 0.5f;
   bool want_probability_map = true;
+  MapKind map_kind = MapKind::kNormalized;
   // Frame budget in ms from the Detect call (frame_budget.h): past its stage shares, proposals
   // and regression degrade in a defined way and Detection::degraded_stages names them. <= 0: no
   // budget.
@@ -58,8 +74,9 @@ struct Detection {
   int height = 0;
   std::vector<Proposal> proposals;  // descending fused score, at most max_proposals
   std::vector<DetectedObstacle> obstacles;
-  cv::Mat1f probability;  // image size, [0,1]; empty unless requested
-  StageTimes timings;     // per stage, in pipeline order, milliseconds
+  cv::Mat1f probability;                    // image size, [0,1]; empty unless requested
+  MapKind map_kind = MapKind::kNormalized;  // the kind of `probability` (and of the obstacles)
+  StageTimes timings;                       // per stage, in pipeline order, milliseconds
   // Stages the frame budget cut short ("proposals", "regression"); empty: the full result.
   std::vector<std::string> degraded_stages;
   bool degraded() const { return !degraded_stages.empty(); }

@@ -72,11 +72,15 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   std::map<std::string, RecallAccumulator> recall;
   for (const auto& v : ProposalVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
   for (const auto& v : RegressionVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
+  const bool calibrated_map = bundle.params.obstacle_calibration.fitted;
+  std::vector<std::string> map_variants = RegressionVariants();
+  if (calibrated_map) map_variants.push_back(kCalibratedMapVariant);
   std::map<std::string, PixelRocAccumulator> roc;
-  for (const auto& v : RegressionVariants()) roc.emplace(v, PixelRocAccumulator());
   std::map<std::string, PixelHistogramAccumulator> served_map_histograms;  // AP, FPR95
-  for (const auto& v : RegressionVariants())
+  for (const auto& v : map_variants) {
+    roc.emplace(v, PixelRocAccumulator());
     served_map_histograms.emplace(v, PixelHistogramAccumulator());
+  }
   std::map<std::string, std::vector<double>> stage_ms;
   ReportedObstacleCounts alarms;
   bool road_labelled = false, not_obstacle = false;
@@ -150,6 +154,13 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const cv::Mat1f map_op_ordr =
         AccumulateProbabilityMap(op_ordr, s.image.size(), bundle.params.probability_map);
     const float min_score = bundle.params.probability_map.min_score;
+    cv::Mat1f map_calibrated;
+    if (calibrated_map) {
+      Result<cv::Mat1f> made =
+          ServedProbabilityMap(bp_fusion, s.image.size(), bundle.params, MapKind::kCalibrated);
+      if (!made.ok()) return made.status();
+      map_calibrated = std::move(*made);
+    }
 
     // Reported obstacles at the detector's defaults (calibrated score >= 0.5).
     const std::vector<DetectedObstacle> reported =
@@ -189,6 +200,10 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     served_map_histograms.at("OP+ORDR@4").Add(map_op_ordr, s.obstacle, s.road);
     served_map_histograms.at("BP+ORDR@4").Add(map_bp_ordr, s.obstacle, s.road);
     served_map_histograms.at("BP+Fusion@4").Add(map_fusion, s.obstacle, s.road);
+    if (calibrated_map) {
+      roc.at(kCalibratedMapVariant).Add(map_calibrated, s.obstacle, s.road);
+      served_map_histograms.at(kCalibratedMapVariant).Add(map_calibrated, s.obstacle, s.road);
+    }
     for (const auto& [stage, ms] : timer.times()) {
       if (!stage_ms.count(stage)) stage_order.push_back(stage);
       stage_ms[stage].push_back(ms);
@@ -214,8 +229,8 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
                           ? "every non-void pixel that is not an obstacle (no road label)"
                           : "the road label (free space)";
   for (const auto& v : ProposalVariants()) report.proposals[v] = Curves(recall.at(v));
-  for (const auto& v : RegressionVariants()) {
-    report.regression[v] = Curves(recall.at(v));
+  for (const auto& v : RegressionVariants()) report.regression[v] = Curves(recall.at(v));
+  for (const auto& v : map_variants) {
     report.roc[v] = roc.at(v).Curve();
     for (double fpr : TableFprs()) report.tpr_at_fpr[v][fpr] = TprAtFpr(report.roc[v], fpr);
     const PixelHistogramAccumulator& histograms = served_map_histograms.at(v);
@@ -227,6 +242,12 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   for (const auto& stage : stage_order)
     report.stage_median_ms.emplace_back(stage, Median(stage_ms[stage]));
   return report;
+}
+
+std::vector<std::string> PixelMapVariants(const EvalReport& report) {
+  std::vector<std::string> variants = RegressionVariants();
+  if (report.roc.count(kCalibratedMapVariant)) variants.push_back(kCalibratedMapVariant);
+  return variants;
 }
 
 nlohmann::json EvalReportToJson(const EvalReport& r) {
@@ -260,6 +281,16 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
                           {"ar", ar(r.regression.at(v))},
                           {"ap", NumberOrNull(r.average_precision.at(v))},
                           {"fpr_at_tpr95", NumberOrNull(r.fpr_at_tpr95.at(v))}};
+  }
+  j["calibrated_map"] = nullptr;
+  if (r.roc.count(kCalibratedMapVariant)) {
+    nlohmann::json tpr = nlohmann::json::object();
+    for (const auto& [fpr, t] : r.tpr_at_fpr.at(kCalibratedMapVariant)) tpr[Fixed(fpr)] = t;
+    j["calibrated_map"] = {
+        {"boxes", "BP+Fusion@4"},
+        {"tpr_at_fpr", tpr},
+        {"ap", NumberOrNull(r.average_precision.at(kCalibratedMapVariant))},
+        {"fpr_at_tpr95", NumberOrNull(r.fpr_at_tpr95.at(kCalibratedMapVariant))}};
   }
   j["timing_ms"] = nlohmann::json::object();
   for (const auto& [stage, ms] : r.stage_median_ms) j["timing_ms"][stage] = ms;
@@ -306,7 +337,7 @@ std::string FormatEvalTables(const EvalReport& r) {
   o << line;
   for (double f : TableFprs()) o << "   " << Fixed(f);
   o << "\n";
-  for (const auto& v : RegressionVariants()) {
+  for (const auto& v : PixelMapVariants(r)) {
     std::snprintf(line, sizeof line, "%-16s", v.c_str());
     o << line;
     for (double f : TableFprs()) o << "   " << Fixed(r.tpr_at_fpr.at(v).at(f));
@@ -316,12 +347,15 @@ std::string FormatEvalTables(const EvalReport& r) {
   std::snprintf(line, sizeof line, "%-16s %7s %7s\n", "variant", "AP", "FPR95");
   o << line;
   const auto defined = [](double v) { return std::isnan(v) ? std::string("n/a") : Fixed(v); };
-  for (const auto& v : RegressionVariants()) {
+  for (const auto& v : PixelMapVariants(r)) {
     std::snprintf(line, sizeof line, "%-16s %7s %7s\n", v.c_str(),
                   defined(r.average_precision.at(v)).c_str(),
                   defined(r.fpr_at_tpr95.at(v)).c_str());
     o << line;
   }
+  if (r.roc.count(kCalibratedMapVariant))
+    o << "(" << kCalibratedMapVariant
+      << ": the calibrated map of BP+Fusion@4's boxes, not divided by the frame's maximum)\n";
   o << "\nAverage recall (regressed, score > 0.25)\n";
   for (const auto& v : RegressionVariants()) ar_row(v, r.regression.at(v));
   o << "\nMedian time per frame (ms)\n";

@@ -39,6 +39,11 @@ inline const std::vector<std::string>& RegressionVariants() {
   return v;
 }
 
+// The calibrated map (probability_map.h) of BP+Fusion@4's boxes, evaluated beside the paper's
+// maps when the bundle has a fitted calibration. It ranks the same boxes, so it has pixel metrics
+// but no recall of its own.
+inline constexpr const char* kCalibratedMapVariant = "BP+Fusion@4 cal";
+
 struct VariantCurves {
   std::vector<int> n_grid;             // 0, 5, ..., 1000
   std::vector<double> recall_at_07;    // recall vs N at IoU 0.7
@@ -67,7 +72,7 @@ struct EvalReport {
   int instances = 0;
   std::map<std::string, VariantCurves> proposals;   // proposal variants
   std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)
-  std::map<std::string, RocCurve> roc;              // regression variants
+  std::map<std::string, RocCurve> roc;              // regression variants (+ kCalibratedMapVariant)
   std::map<std::string, std::map<double, double>> tpr_at_fpr;
   // On the served 8-bit map (core/metrics/pixel_histogram_metrics.h), regression variants:
   // NaN when undefined (no obstacle pixel; for FPR also no free-space pixel).
@@ -79,8 +84,14 @@ struct EvalReport {
 
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options);
 
+// The variants with pixel metrics in `report`: RegressionVariants(), then kCalibratedMapVariant
+// when it was evaluated.
+std::vector<std::string> PixelMapVariants(const EvalReport& report);
+
 // The JSON of the issue: {"frames","instances","proposals":{V:{"ar":{...}}},
 // "regression":{V:{"tpr_at_fpr":{...},"ar":{...},"ap":x,"fpr_at_tpr95":x}},
+// "calibrated_map":{"boxes":"BP+Fusion@4","tpr_at_fpr":{...},"ap":x,"fpr_at_tpr95":x} (null
+// without a fitted calibration),
 // "timing_ms":{STAGE:x,...,"total":x}}; an undefined "ap" / "fpr_at_tpr95" is null.
 nlohmann::json EvalReportToJson(const EvalReport& report);
 // The two tables and the timing table as text.

@@ -23,6 +23,14 @@ std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
   return out;
 }
 
+Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
+                                       cv::Size image_size, const PipelineParams& params,
+                                       MapKind kind) {
+  if (kind == MapKind::kCalibrated)
+    return CalibratedProbabilityMap(fused_boxes, image_size, params.obstacle_calibration);
+  return AccumulateProbabilityMap(fused_boxes, image_size, params.probability_map);
+}
+
 namespace {
 
 // The manifest's training data: one root, or several joined by " + ".
@@ -89,11 +97,13 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   std::vector<ScoredBox> scored(fused.size());
   for (std::size_t i = 0; i < fused.size(); ++i)
     scored[i] = {regressed.proposals.boxes[i].box, fused[i]};
-  const cv::Mat1f probability =
-      AccumulateProbabilityMap(scored, bgr.size(), bundle_.params.probability_map);
+  Result<cv::Mat1f> probability =
+      ServedProbabilityMap(scored, bgr.size(), bundle_.params, options.map_kind);
+  if (!probability.ok()) return probability.status();
+  out.map_kind = options.map_kind;
   out.width = bgr.cols;
   out.height = bgr.rows;
-  out.obstacles = ScoreObstacles(probability, scored, bundle_.params, options);
+  out.obstacles = ScoreObstacles(*probability, scored, bundle_.params, options);
   timer.Mark("probability_map");
 
   std::vector<std::size_t> order(fused.size());
@@ -108,7 +118,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
     out.proposals.push_back(
         {regressed.proposals.boxes[i].box, fused[i], regressed.ordr[i], regressed.obdr[i]});
   }
-  if (options.want_probability_map) out.probability = probability;
+  if (options.want_probability_map) out.probability = std::move(*probability);
   out.timings = timer.times();
   return out;
 }

@@ -18,6 +18,13 @@ std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
                                              const PipelineParams& params,
                                              const DetectOptions& options);
 
+// The map a detection serves: the paper's normalised sum (§7) or the calibrated map, from the
+// fused boxes of the frame. FailedPrecondition for the calibrated map of a bundle without a
+// fitted calibration.
+Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
+                                       cv::Size image_size, const PipelineParams& params,
+                                       MapKind kind);
+
 class ObstacleDetector final : public Detector {
  public:
   ObstacleDetector(ModelBundle bundle, std::string name);

@@ -75,6 +75,11 @@ cv::Mat3b RenderLineChart(const PlotSpec& spec, const std::vector<PlotSeries>& s
   cv::rotate(ylabel, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
   rotated.copyTo(img(cv::Rect(5, top + std::max(0, (area.height - rotated.rows) / 2), rotated.cols,
                               rotated.rows)));
+  // The legend sits right-aligned, as wide as its longest label.
+  int label_width = 0;
+  for (const PlotSeries& one : series)
+    label_width = std::max(label_width, cv::getTextSize(one.label, font, 0.5, 1, nullptr).width);
+  const int legend_x = area.x + area.width - std::max(230, label_width + 48);
   for (std::size_t s = 0; s < series.size(); ++s) {
     const cv::Scalar colour = kPalette[s % (sizeof kPalette / sizeof kPalette[0])];
     std::vector<cv::Point> pts;
@@ -82,7 +87,7 @@ cv::Mat3b RenderLineChart(const PlotSpec& spec, const std::vector<PlotSeries>& s
       pts.push_back(px(std::clamp(series[s].x[i], spec.x_min, spec.x_max),
                        std::clamp(series[s].y[i], spec.y_min, spec.y_max)));
     if (pts.size() >= 2) cv::polylines(img, pts, false, colour, 2, cv::LINE_AA);
-    const cv::Point legend(area.x + area.width - 230, area.y + 20 + 22 * static_cast<int>(s));
+    const cv::Point legend(legend_x, area.y + 20 + 22 * static_cast<int>(s));
     cv::line(img, legend, legend + cv::Point(30, 0), colour, 3);
     cv::putText(img, series[s].label, legend + cv::Point(38, 5), font, 0.5, {0, 0, 0}, 1,
                 cv::LINE_AA);
@@ -104,8 +109,8 @@ Status WriteEvalPlots(const EvalReport& report, const std::string& dir) {
     ar.push_back({name, to_double(c.n_grid), c.average_recall});
   };
   for (const auto& v : ProposalVariants()) add(v, report.proposals.at(v));
-  for (const auto& v : RegressionVariants()) {
-    add(v, report.regression.at(v));
+  for (const auto& v : RegressionVariants()) add(v, report.regression.at(v));
+  for (const auto& v : PixelMapVariants(report)) {
     roc.push_back({v, report.roc.at(v).fpr, report.roc.at(v).tpr});
     // The legend carries the AP, the area under the step curve.
     pr.push_back(PrecisionRecallSteps(v + " (" + ApLabel(report.average_precision.at(v)) + ")",

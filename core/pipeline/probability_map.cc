@@ -80,6 +80,28 @@ cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size
   return prob;
 }
 
+Result<cv::Mat1f> CalibratedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
+                                           cv::Size image_size,
+                                           const ObstacleCalibration& calibration) {
+  if (!calibration.fitted)
+    return Status::FailedPrecondition(
+        "the model has no fitted obstacle calibration (made before `tod train` fitted one): "
+        "the calibrated map needs it; ask for the normalized map");
+  std::vector<ScoredBox> gated;
+  for (const ScoredBox& b : fused_boxes)
+    if (b.score > 0.f) gated.push_back(b);
+  // Weakest first: a later (stronger) box overwrites, which is the max without comparing.
+  std::stable_sort(gated.begin(), gated.end(),
+                   [](const ScoredBox& a, const ScoredBox& b) { return a.score < b.score; });
+  cv::Mat1f map(image_size, 0.f);
+  for (const ScoredBox& b : gated) {
+    const Box clipped = ClipToImage(b.box, image_size.width, image_size.height);
+    if (clipped.empty()) continue;
+    map(clipped.rect()).setTo(static_cast<float>(CalibratedScore(calibration, b.score)));
+  }
+  return map;
+}
+
 std::vector<ObstacleComponent> ThresholdObstacles(const cv::Mat1f& probability, float threshold) {
   std::vector<ObstacleComponent> out;
   if (probability.empty()) return out;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/base/types.h"
+#include "core/pipeline/obstacle_calibration.h"
 
 namespace tod {
 
@@ -45,6 +46,17 @@ float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_b
 // sums, so the cost is linear in boxes plus pixels), normalise by the maximum.
 cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
                                    const ProbabilityMapParams& params = {});
+
+// The calibrated map (not in the paper): each pixel holds CalibratedScore(F) of the box with the
+// largest fused score F over it, among every box with F > 0 (every box the ORDR gate passed).
+// Unlike the paper's map it is not divided by a per-frame maximum, so its values mean the same on
+// every frame (an empty road stays low), and it is not a sum, so the road inside a strong box's
+// corners is not raised further by the weaker boxes around it. Cost: the gated boxes' areas
+// (painted weakest first, each paint overwrites). Refuses a calibration that was not fitted: its
+// scores would not be probabilities.
+Result<cv::Mat1f> CalibratedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
+                                           cv::Size image_size,
+                                           const ObstacleCalibration& calibration);
 
 struct ObstacleComponent {
   Box box;

@@ -133,6 +133,20 @@ TEST_F(BenchCliTest, FrameBudgetDegradationIsReportedByBenchAndDetect) {
   const nlohmann::json d = nlohmann::json::parse(detect_json);
   EXPECT_EQ(d["degraded"], true) << d.dump();
   EXPECT_EQ(d["degraded_stages"][0], "proposals");
+  EXPECT_EQ(d["map_kind"], "normalized");
+
+  // The calibrated map: named in the JSON; its peak is the calibrated score of the best box, not
+  // the 1 every normalised map has (unless the model is certain).
+  const CommandResult calibrated =
+      RunCommand(tod_ + " detect --model " + model_ + " --out " + detect_out.string() +
+                 " --map-kind calibrated " + (frames_ / "a.png").string());
+  ASSERT_EQ(calibrated.exit_code, 0) << calibrated.output;
+  std::ifstream calibrated_json(detect_out / "a.json");
+  EXPECT_EQ(nlohmann::json::parse(calibrated_json)["map_kind"], "calibrated");
+  const CommandResult unknown_kind =
+      RunCommand(tod_ + " detect --model " + model_ + " --out " + detect_out.string() +
+                 " --map-kind sum " + (frames_ / "a.png").string());
+  EXPECT_NE(unknown_kind.exit_code, 0) << unknown_kind.output;
 
   const CommandResult refused = Bench("--frame-budget-ms -5");
   EXPECT_NE(refused.exit_code, 0) << refused.output;

@@ -101,6 +101,12 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
   EXPECT_GT(j["frames"].get<int>(), 0);
   EXPECT_GT(j["instances"].get<int>(), 0);
   EXPECT_TRUE(j["regression"]["BP+Fusion@4"].contains("ap"));
+  // The calibrated map is evaluated beside the paper's, since the model has a calibration.
+  ASSERT_TRUE(j["calibrated_map"].is_object()) << j.dump();
+  EXPECT_EQ(j["calibrated_map"]["boxes"], "BP+Fusion@4");
+  EXPECT_TRUE(j["calibrated_map"]["tpr_at_fpr"].contains("0.020"));
+  EXPECT_TRUE(j["calibrated_map"].contains("ap"));
+  EXPECT_NE(eval.output.find("BP+Fusion@4 cal"), std::string::npos) << eval.output;
   for (const char* key : {"false_alarms_per_frame", "false_alarms_per_obstacle_free_frame",
                           "obstacle_free_frames", "instances_found"})
     EXPECT_TRUE(j["obstacles"].contains(key)) << key;

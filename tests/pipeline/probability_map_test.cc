@@ -76,5 +76,42 @@ TEST(RankedAboveThreshold, StrictAndSorted) {
   EXPECT_FLOAT_EQ(r[1].score, 0.3f);
 }
 
+TEST(CalibratedProbabilityMap, EachPixelHoldsTheCalibratedScoreOfItsStrongestGatedBox) {
+  ObstacleCalibration calibration;
+  calibration.fitted = true;
+  calibration.slope = 6.0;
+  calibration.intercept = -3.0;
+  const std::vector<ScoredBox> boxes = {
+      {{10, 10, 20, 20}, 0.4f}, {{15, 15, 10, 10}, 0.9f},  // nested: the stronger one wins
+      {{18, 12, 20, 5}, 0.6f},                             // overlaps both
+      {{50, 40, 30, 30}, 0.f},                             // gated out (F = 0): not painted
+      {{70, 0, 40, 10}, 0.3f},                             // runs past the right border
+  };
+  const cv::Size size(100, 60);
+  auto map = CalibratedProbabilityMap(boxes, size, calibration);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  // Reference: for every pixel, the box with the largest F over it.
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      float best = 0.f;
+      for (const ScoredBox& b : boxes)
+        if (b.score > 0.f && b.box.rect().contains({x, y})) best = std::max(best, b.score);
+      const float expected =
+          best > 0.f ? static_cast<float>(CalibratedScore(calibration, best)) : 0.f;
+      ASSERT_FLOAT_EQ((*map)(y, x), expected) << x << "," << y;
+    }
+  // Not divided by a per-frame maximum: a frame of weak boxes stays low.
+  double peak = 0;
+  cv::minMaxLoc(*map, nullptr, &peak);
+  EXPECT_NEAR(peak, CalibratedScore(calibration, 0.9), 1e-6);
+  EXPECT_LT(peak, 1.0);
+}
+
+TEST(CalibratedProbabilityMap, RefusesAnUnfittedCalibration) {
+  const auto map = CalibratedProbabilityMap({{{0, 0, 4, 4}, 0.5f}}, {8, 8}, ObstacleCalibration{});
+  ASSERT_FALSE(map.ok());
+  EXPECT_EQ(map.status().code(), StatusCode::kFailedPrecondition);
+}
+
 }  // namespace
 }  // namespace tod

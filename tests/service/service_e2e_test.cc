@@ -5,6 +5,7 @@
 #include <httplib.h>
 #include <signal.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -263,6 +264,48 @@ TEST_F(ServiceE2ETest, AFrameOverItsBudgetDegradesSaysSoAndIsCounted) {
   }
   request.mutable_options()->set_budget_ms(700'000);
   EXPECT_EQ(grpc_->Detect(request, &response).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+TEST_F(ServiceE2ETest, TheCalibratedMapPeaksAtTheCalibratedScoreOfTheBestBox) {
+  const std::string frame = testing::RoadPng();
+  tod::v1::ModelInfo info;
+  ASSERT_TRUE(grpc_->GetModelInfo(&info).ok());
+  const nlohmann::json calibration =
+      nlohmann::json::parse(info.manifest_json())["params"]["obstacle_calibration"];
+  ASSERT_TRUE(calibration["fitted"].get<bool>()) << calibration.dump();
+  const auto peak_of = [](const std::string& png) {
+    const cv::Mat map =
+        cv::imdecode(std::vector<uchar>(png.begin(), png.end()), cv::IMREAD_UNCHANGED);
+    double peak = -1;
+    if (!map.empty()) cv::minMaxLoc(map, nullptr, &peak);
+    return peak;
+  };
+
+  tod::v1::DetectRequest request = MakeRequest(frame);
+  request.mutable_options()->set_map_kind(tod::v1::MAP_KIND_CALIBRATED);
+  tod::v1::DetectResponse response;
+  ASSERT_TRUE(grpc_->Detect(request, &response).ok());
+  EXPECT_EQ(response.probability_map().kind(), tod::v1::MAP_KIND_CALIBRATED);
+  ASSERT_GE(response.proposals_size(), 1);
+  const double best = response.proposals(0).fused();  // proposals come best first
+  ASSERT_GT(best, 0.0);
+  const double expected = 255.0 / (1.0 + std::exp(-(calibration["slope"].get<double>() * best +
+                                                    calibration["intercept"].get<double>())));
+  EXPECT_NEAR(peak_of(response.probability_map().png()), expected, 1.0);
+
+  const auto rest = PostImage(*http_, "/v1/detect?map_kind=calibrated", frame);
+  ASSERT_TRUE(rest);
+  ASSERT_EQ(rest->status, 200) << rest->body;
+  EXPECT_EQ(nlohmann::json::parse(rest->body)["probability_map"]["kind"], "MAP_KIND_CALIBRATED");
+  const auto normalized = PostImage(*http_, "/v1/probability-map?map_kind=normalized", frame);
+  ASSERT_TRUE(normalized);
+  ASSERT_EQ(normalized->status, 200);
+  EXPECT_EQ(peak_of(normalized->body), 255.0);  // the paper's map: divided by its maximum
+
+  const auto refused = PostImage(*http_, "/v1/detect?map_kind=sum", frame);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400);
+  EXPECT_NE(ErrorMessage(refused).find("map_kind"), std::string::npos) << refused->body;
 }
 
 TEST_F(ServiceE2ETest, RestErrorsHaveCodesAndMessages) {
