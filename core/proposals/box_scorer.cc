@@ -53,7 +53,8 @@ BoxScorer::BoxScorer(const cv::Mat1f& edge_map, const EdgeBoxParams& params, int
     : width_(edge_map.cols),
       height_(edge_map.rows),
       params_(params),
-      refine_ratio_((1.f - params.alpha) / (1.f + params.alpha)) {
+      refine_ratio_((1.f - params.alpha) / (1.f + params.alpha)),
+      skip_groupless_windows_(params.min_score > 1e-6f) {
   auto tables = std::make_shared<Tables>();
   Tables& t = *tables;
   // Every table below only changes at edge pixels (a few % of the map): they are all built from
@@ -290,23 +291,42 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
     // several windows overlap. Why it is exact: every window still gets the same operations on
     // the same values, the walks run in the same order, and hits are appended in the same order.
     reached_.clear();
+    const auto grid_rows = [&](int begin, int end) {
+      end = std::min(end, unclamped_end);
+      const int first = grid_row_from(begin);
+      return first < end ? (end - first + stride_y - 1) / stride_y : 0;
+    };
     const auto scan = [&](int begin, int end) {
       end = std::min(end, unclamped_end);
       for (y = grid_row_from(begin); y < end; y += stride_y) {
-        ++visited;
         const int inner_r0 = y + inner_offset;
         if (t_->bound.Reaches(columns, y, y + box_height, inner_r0, inner_r0 + half_h, threshold)) {
           reached_.push_back(y);
         }
       }
     };
+    const std::pair<int, int> whole_column(0, unclamped_end);
+    const std::pair<int, int>* const admitted_begin = tops ? tops->data() : &whole_column;
+    const std::pair<int, int>* const admitted_end =
+        tops ? tops->data() + tops->size() : &whole_column + 1;
+    // Every admitted window counts as visited, whether the bound or the interior test decided it.
+    for (const auto* a = admitted_begin; a != admitted_end; ++a)
+      visited += grid_rows(a->first, a->second);
     if (threshold == ContainmentBound::kNever) {
-      // No window of this size can pass: they count as visited, the bound decided them all.
-      visited += (unclamped_end + stride_y - 1) / stride_y;
-    } else if (tops == nullptr) {
-      scan(0, unclamped_end);
+      // No window of this size can pass: the bound decided them all.
+    } else if (skip_groupless_windows_ &&
+               t_->bound.InteriorTops(c0, c1, box_height, kMaxListedGroups, interior_tops_)) {
+      // Only windows that can hold a whole group: the admitted ranges intersected with those,
+      // both sorted and disjoint, so the grid rows are scanned in the same ascending order.
+      const auto* a = admitted_begin;
+      auto g = interior_tops_.begin();
+      while (a != admitted_end && g != interior_tops_.end()) {
+        const int begin = std::max(a->first, g->first), end = std::min(a->second, g->second);
+        if (begin < end) scan(begin, end);
+        (a->second < g->second) ? void(++a) : void(++g);
+      }
     } else {
-      for (const auto& [begin, end] : *tops) scan(begin, end);
+      for (const auto* a = admitted_begin; a != admitted_end; ++a) scan(a->first, a->second);
     }
     // Pass 2: v of ScoreAfterBound and its early exit.
     const size_t stride = static_cast<size_t>(height_) + 1;

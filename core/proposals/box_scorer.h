@@ -179,6 +179,12 @@ class BoxScorer {
   };
   std::vector<int> reached_;
   std::vector<Hopeful> hopeful_;
+  RowRanges interior_tops_;  // ContainmentBound::InteriorTops of the column
+  // ScoreColumn skips the windows without a whole group in their interior (they score 0) when
+  // min_score is positive, so that no rounding residue of v - removed could score; the column
+  // is listed only when at most kMaxListedGroups groups start in it.
+  bool skip_groupless_windows_ = false;
+  static constexpr int kMaxListedGroups = 32;
 };
 
 }  // namespace tod

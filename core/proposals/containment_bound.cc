@@ -28,6 +28,11 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& e
       y1[s] = std::max(y1[s], r);
     }
   }
+  group_boxes_.reserve(n);
+  for (int s = 1; s <= n; ++s)
+    if (x1[s] >= 0) group_boxes_.push_back({x0[s], x1[s], y0[s], y1[s]});
+  std::stable_sort(group_boxes_.begin(), group_boxes_.end(),
+                   [](const GroupBox& a, const GroupBox& b) { return a.c0 < b.c0; });
   double total_magnitude = 0.0, total_edge = 0.0;
   for (int s = 1; s <= n; ++s) total_magnitude += groups.magnitude[s];
   // Row-major, the order of a full scan of the map: the same double sum.
@@ -104,6 +109,34 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& e
     }
     for (; r <= height; ++r) here[r] = left[r] + sum;
   }
+}
+
+bool ContainmentBound::InteriorTops(int c0, int c1, int box_height, int max_groups,
+                                    std::vector<std::pair<int, int>>& tops) const {
+  tops.clear();
+  // Groups starting in the interior's columns [c0 + 1, c1 - 1].
+  const auto first = std::lower_bound(group_boxes_.begin(), group_boxes_.end(), c0 + 1,
+                                      [](const GroupBox& g, int column) { return g.c0 < column; });
+  const auto last = std::upper_bound(first, group_boxes_.end(), c1 - 1,
+                                     [](int column, const GroupBox& g) { return column < g.c0; });
+  if (last - first > max_groups) return false;
+  for (auto g = first; g != last; ++g) {
+    if (g->c1 > c1 - 1) continue;
+    // Interior rows [y + 1, y + box_height - 1] hold rows [r0, r1]: y in [r1 - h + 1, r0 - 1].
+    const int begin = g->r1 - box_height + 1, end = g->r0;
+    if (begin < end) tops.emplace_back(begin, end);
+  }
+  std::sort(tops.begin(), tops.end());
+  size_t merged = 0;
+  for (size_t i = 0; i < tops.size(); ++i) {
+    if (merged > 0 && tops[i].first <= tops[merged - 1].second) {
+      tops[merged - 1].second = std::max(tops[merged - 1].second, tops[i].second);
+    } else {
+      tops[merged++] = tops[i];
+    }
+  }
+  tops.resize(merged);
+  return true;
 }
 
 }  // namespace tod

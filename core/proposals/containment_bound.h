@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <utility>
 #include <vector>
 
 #include "core/proposals/edge_groups.h"
@@ -100,6 +101,17 @@ class ContainmentBound {
     }
     return true;
   }
+  // The tops y of a column's windows (rows [y, y + box_height], columns [c0, c1]) whose strict
+  // interior holds a whole group, as sorted disjoint [begin, end) ranges in `tops`. Only those
+  // windows can score above 0: by the argument above, every group anchored inside a window
+  // that is not wholly in its interior touches a side, gets weight 1 and is removed, so
+  // v - removed <= -(centre-box edges) <= 0 without one. Sparse maps leave most of a column
+  // without such a window, and listing the few groups in the columns is cheaper than testing
+  // every window. Returns false (tops unspecified) when more than max_groups groups start in
+  // the interior's columns: then listing them would cost more than the scan it saves.
+  bool InteriorTops(int c0, int c1, int box_height, int max_groups,
+                    std::vector<std::pair<int, int>>& tops) const;
+
   double ToMagnitude(std::int64_t fixed) const {
     return static_cast<double>(fixed) * inverse_scale_ + margin_;
   }
@@ -138,6 +150,11 @@ class ContainmentBound {
   double margin_ = 0.0;         // covers the double rounding of the exact score
   std::vector<Cell> cells_;
   std::vector<std::uint32_t> edges_;  // M where M > edge_min_mag, rounded down
+  // Every group's bounding box (inclusive), by first column.
+  struct GroupBox {
+    int c0 = 0, c1 = 0, r0 = 0, r1 = 0;
+  };
+  std::vector<GroupBox> group_boxes_;
 };
 
 }  // namespace tod

@@ -3,6 +3,7 @@
 // window-by-window loop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -78,6 +79,39 @@ TEST(ContainmentBoundTest, EnclosedContourIsCountedAndCutContourIsNot) {
   EXPECT_LE(bound.Bound(10, 10, 11, 19, 10, 12, 10, 16), 0.0 + 1e-6);
 }
 
+TEST(ContainmentBoundTest, WindowsOutsideTheInteriorTopsAllScoreZero) {
+  const EdgeBoxParams params;
+  const cv::Mat1f map = testing::RandomContourMap(240, 160, 4, 4);  // sparse: 4 outlines
+  const EdgeGroups groups = GroupsOf(map, params);
+  const ContainmentBound bound(groups, map, params.edge_min_mag);
+  BoxScorer scorer(map, params);
+  std::mt19937 rng(8);
+  std::uniform_int_distribution<int> cx(0, map.cols - 1), size(3, 120);
+  int listed = 0, skipped_windows = 0;
+  std::vector<std::pair<int, int>> tops;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int c0 = cx(rng), c1 = std::min(map.cols - 1, c0 + size(rng));
+    const int h = size(rng);
+    if (!bound.InteriorTops(c0, c1, h, 32, tops)) continue;
+    ++listed;
+    for (size_t i = 1; i < tops.size(); ++i) ASSERT_LT(tops[i - 1].second, tops[i].first);
+    for (int y = 0; y + h < map.rows; ++y) {
+      const bool inside = std::any_of(tops.begin(), tops.end(), [&](const auto& range) {
+        return y >= range.first && y < range.second;
+      });
+      if (inside) continue;
+      ++skipped_windows;
+      ScoreWindow w{y, c0, y + h, c1, 0.f};
+      scorer.Score(w);
+      ASSERT_EQ(w.score, 0.f) << c0 << "," << y << "," << c1 << "," << y + h;
+    }
+  }
+  EXPECT_GT(listed, 200);
+  EXPECT_GT(skipped_windows, 5000);  // the test exercises the skip, not an empty set
+  // A column with more groups than the limit is not listed.
+  EXPECT_FALSE(bound.InteriorTops(0, map.cols - 1, 50, 0, tops) && groups.count() > 0);
+}
+
 // The plain definition: every grid window through BoxScorer::Score, refined, then NMS.
 std::vector<ScoredBox> PlainScan(const cv::Mat1f& map, const EdgeBoxParams& params) {
   BoxScorer scorer(map, params);
@@ -111,6 +145,23 @@ TEST(ScoreEdgeBoxesTest, ColumnScanAndThreadsEqualThePlainWindowLoop) {
         EXPECT_EQ(got[i].score, expected[i].score);
       }
     }
+  }
+}
+
+TEST(ScoreEdgeBoxesTest, ColumnScanEqualsThePlainWindowLoopOnASparseMap) {
+  // Few outlines on a large map: most columns list their groups and skip the windows that
+  // cannot hold one (BoxScorer::ScoreColumn); nothing may change.
+  const cv::Mat1f map = testing::RandomContourMap(260, 180, 12, 3);
+  EdgeBoxParams params;
+  const std::vector<ScoredBox> expected = PlainScan(map, params);
+  ASSERT_GT(expected.size(), 10u);
+  EdgeBoxStats stats;
+  const std::vector<ScoredBox> got = ScoreEdgeBoxes(map, params, &stats);
+  EXPECT_EQ(stats.windows_visited, CountWindows(map.cols, map.rows, params));
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i].box, expected[i].box) << i;
+    EXPECT_EQ(got[i].score, expected[i].score) << i;
   }
 }
 
