@@ -72,6 +72,9 @@ void HandleDetect(const tod::server::http::Request& request) {
     const tod::DetectOptions& options = inference.options;
     Check(options.max_proposals >= 0 && options.max_proposals <= tod::server::kMaxRestProposals);
     Check(options.obstacle_threshold >= 0.f && options.obstacle_threshold <= 1.f);
+    // Only the two named kinds parse; any other value was refused above.
+    Check(options.map_kind == tod::MapKind::kNormalized ||
+          options.map_kind == tod::MapKind::kCalibrated);
   } else {
     const auto response =
         tod::server::http::JsonErrorResponse(400, "INVALID_ARGUMENT", status.message());
