@@ -42,7 +42,8 @@ Runner AddDetectCommand(CLI::App& app) {
          [args](const std::string& name) { args->options.map_kind = *ParseMapKind(name); },
          "probability map written and thresholded: normalized (the paper's, default) or "
          "calibrated")
-      ->check(CLI::IsMember({"normalized", "calibrated"}));
+      ->check(
+          CLI::IsMember({MapKindName(MapKind::kNormalized), MapKindName(MapKind::kCalibrated)}));
   AddFrameRequestOptions(cmd, &args->options);
   cmd->add_flag(
       "--stages", args->stages,

@@ -68,6 +68,12 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   if (bgr.cols < 16 || bgr.rows < 16)
     return Status::InvalidArgument("image too small: " + std::to_string(bgr.cols) + "x" +
                                    std::to_string(bgr.rows) + " (at least 16x16)");
+  // A map the bundle cannot make is refused before any stage runs, not after the whole frame.
+  if (options.map_kind == MapKind::kCalibrated) {
+    if (Status available = CalibratedMapAvailable(bundle_.params.obstacle_calibration);
+        !available.ok())
+      return available;
+  }
   StageTimer timer(options.cancelled);  // asks options.cancelled at every stage boundary
   const FrameBudget budget(std::chrono::steady_clock::now(), options.budget_ms);
   const int threads = std::max(1, options.threads);

@@ -80,13 +80,17 @@ cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size
   return prob;
 }
 
+Status CalibratedMapAvailable(const ObstacleCalibration& calibration) {
+  if (calibration.fitted) return Status::Ok();
+  return Status::FailedPrecondition(
+      "the model has no fitted obstacle calibration (made before `tod train` fitted one): "
+      "the calibrated map needs it; ask for the normalized map");
+}
+
 Result<cv::Mat1f> CalibratedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
                                            cv::Size image_size,
                                            const ObstacleCalibration& calibration) {
-  if (!calibration.fitted)
-    return Status::FailedPrecondition(
-        "the model has no fitted obstacle calibration (made before `tod train` fitted one): "
-        "the calibrated map needs it; ask for the normalized map");
+  if (Status available = CalibratedMapAvailable(calibration); !available.ok()) return available;
   std::vector<ScoredBox> gated;
   for (const ScoredBox& b : fused_boxes)
     if (b.score > 0.f) gated.push_back(b);

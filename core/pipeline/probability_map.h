@@ -54,6 +54,9 @@ cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size
 // corners is not raised further by the weaker boxes around it. Cost: the gated boxes' areas
 // (painted weakest first, each paint overwrites). Refuses a calibration that was not fitted: its
 // scores would not be probabilities.
+// Ok when CalibratedProbabilityMap can be made with `calibration`; else the FailedPrecondition
+// it returns (a caller checks this before spending work on a frame).
+Status CalibratedMapAvailable(const ObstacleCalibration& calibration);
 Result<cv::Mat1f> CalibratedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
                                            cv::Size image_size,
                                            const ObstacleCalibration& calibration);

@@ -31,6 +31,23 @@ TEST_F(DetectCancellationTest, WithoutAHookEveryStageRuns) {
   }
 }
 
+// The tiny bundle has no fitted calibration: asking for the calibrated map is refused before
+// the first stage (the hook, asked at every boundary, is never asked).
+TEST_F(DetectCancellationTest, AMapTheBundleCannotMakeIsRefusedBeforeAnyWork) {
+  int asked = 0;
+  DetectOptions options;
+  options.map_kind = MapKind::kCalibrated;
+  options.cancelled = [&asked] {
+    ++asked;
+    return Status::Ok();
+  };
+  const Result<Detection> detection = detector_->Detect(frame_, options);
+  ASSERT_FALSE(detection.ok());
+  EXPECT_EQ(detection.status().code(), StatusCode::kFailedPrecondition);
+  EXPECT_NE(detection.status().message().find("calibration"), std::string::npos);
+  EXPECT_EQ(asked, 0);
+}
+
 TEST_F(DetectCancellationTest, AnOkHookIsAskedAtEveryBoundaryAndChangesNothing) {
   int asked = 0;
   DetectOptions options;
