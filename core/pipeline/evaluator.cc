@@ -156,8 +156,8 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const float min_score = bundle.params.probability_map.min_score;
     cv::Mat1f map_calibrated;
     if (calibrated_map) {
-      Result<cv::Mat1f> made =
-          ServedProbabilityMap(bp_fusion, s.image.size(), bundle.params, MapKind::kCalibrated);
+      Result<cv::Mat1f> made = ServedProbabilityMap(bp_fusion, s.image.size(), oaocc, bundle.params,
+                                                    MapKind::kCalibrated);
       if (!made.ok()) return made.status();
       map_calibrated = std::move(*made);
     }

@@ -24,10 +24,11 @@ std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
 }
 
 Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
-                                       cv::Size image_size, const PipelineParams& params,
-                                       MapKind kind) {
+                                       cv::Size image_size, const OcclusionEdges& oaocc,
+                                       const PipelineParams& params, MapKind kind) {
   if (kind == MapKind::kCalibrated)
-    return CalibratedProbabilityMap(fused_boxes, image_size, params.obstacle_calibration);
+    return CalibratedProbabilityMap(fused_boxes, image_size, params.obstacle_calibration,
+                                    oaocc.superpixels, oaocc.r1);
   return AccumulateProbabilityMap(fused_boxes, image_size, params.probability_map);
 }
 
@@ -104,7 +105,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   for (std::size_t i = 0; i < fused.size(); ++i)
     scored[i] = {regressed.proposals.boxes[i].box, fused[i]};
   Result<cv::Mat1f> probability =
-      ServedProbabilityMap(scored, bgr.size(), bundle_.params, options.map_kind);
+      ServedProbabilityMap(scored, bgr.size(), oaocc, bundle_.params, options.map_kind);
   if (!probability.ok()) return probability.status();
   out.map_kind = options.map_kind;
   out.width = bgr.cols;

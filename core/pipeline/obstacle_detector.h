@@ -19,11 +19,11 @@ std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
                                              const DetectOptions& options);
 
 // The map a detection serves: the paper's normalised sum (§7) or the calibrated map, from the
-// fused boxes of the frame. FailedPrecondition for the calibrated map of a bundle without a
-// fitted calibration.
+// fused boxes of the frame (and, for the calibrated map, the superpixels of `oaocc`).
+// FailedPrecondition for the calibrated map of a bundle without a fitted calibration.
 Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
-                                       cv::Size image_size, const PipelineParams& params,
-                                       MapKind kind);
+                                       cv::Size image_size, const OcclusionEdges& oaocc,
+                                       const PipelineParams& params, MapKind kind);
 
 class ObstacleDetector final : public Detector {
  public:

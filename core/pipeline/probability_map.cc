@@ -4,6 +4,7 @@
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 
+#include "core/pipeline/superpixel_share.h"
 #include "core/proposals/edge_box_scorer.h"
 
 namespace tod {
@@ -89,20 +90,14 @@ Status CalibratedMapAvailable(const ObstacleCalibration& calibration) {
 
 Result<cv::Mat1f> CalibratedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
                                            cv::Size image_size,
-                                           const ObstacleCalibration& calibration) {
+                                           const ObstacleCalibration& calibration,
+                                           const Superpixels& superpixels, const Box& crop) {
   if (Status available = CalibratedMapAvailable(calibration); !available.ok()) return available;
-  std::vector<ScoredBox> gated;
-  for (const ScoredBox& b : fused_boxes)
-    if (b.score > 0.f) gated.push_back(b);
-  // Weakest first: a later (stronger) box overwrites, which is the max without comparing.
-  std::stable_sort(gated.begin(), gated.end(),
-                   [](const ScoredBox& a, const ScoredBox& b) { return a.score < b.score; });
   cv::Mat1f map(image_size, 0.f);
-  for (const ScoredBox& b : gated) {
-    const Box clipped = ClipToImage(b.box, image_size.width, image_size.height);
-    if (clipped.empty()) continue;
-    map(clipped.rect()).setTo(static_cast<float>(CalibratedScore(calibration, b.score)));
-  }
+  SuperpixelShare share(superpixels, crop);
+  for (const ScoredBox& b : fused_boxes)
+    if (b.score > 0.f)
+      share.PaintMax(b.box, static_cast<float>(CalibratedScore(calibration, b.score)), &map);
   return map;
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/base/types.h"
+#include "core/edges/sticky_superpixels.h"
 #include "core/pipeline/obstacle_calibration.h"
 
 namespace tod {
@@ -47,19 +48,22 @@ float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_b
 cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
                                    const ProbabilityMapParams& params = {});
 
-// The calibrated map (not in the paper): each pixel holds CalibratedScore(F) of the box with the
-// largest fused score F over it, among every box with F > 0 (every box the ORDR gate passed).
-// Unlike the paper's map it is not divided by a per-frame maximum, so its values mean the same on
-// every frame (an empty road stays low), and it is not a sum, so the road inside a strong box's
-// corners is not raised further by the weaker boxes around it. Cost: the gated boxes' areas
-// (painted weakest first, each paint overwrites). Refuses a calibration that was not fitted: its
-// scores would not be probabilities.
+// The calibrated map (not in the paper): each pixel p holds the largest, over every box b with
+// F > 0 (every box the ORDR gate passed) that covers p, of CalibratedScore(F(b)) · share(p, b),
+// the share of p's superpixel that b holds (superpixel_share.h): P(b frames an obstacle) times
+// P(p belongs to what b frames). Unlike the paper's map it is not divided by a per-frame maximum,
+// so its values mean the same on every frame (an empty road stays low); it is not a sum, so the
+// road around a strong box is not raised further by the weaker boxes around it; and the road in a
+// box's corners, whose superpixels run on past the box, stays low. `superpixels` label the crop
+// at `crop` (R1, OcclusionEdges); pixels outside it take the box's score. Cost: twice the gated
+// boxes' areas. Refuses a calibration that was not fitted: its scores would not be probabilities.
 // Ok when CalibratedProbabilityMap can be made with `calibration`; else the FailedPrecondition
 // it returns (a caller checks this before spending work on a frame).
 Status CalibratedMapAvailable(const ObstacleCalibration& calibration);
 Result<cv::Mat1f> CalibratedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
                                            cv::Size image_size,
-                                           const ObstacleCalibration& calibration);
+                                           const ObstacleCalibration& calibration,
+                                           const Superpixels& superpixels, const Box& crop);
 
 struct ObstacleComponent {
   Box box;

@@ -88,7 +88,9 @@ TEST(CalibratedProbabilityMap, EachPixelHoldsTheCalibratedScoreOfItsStrongestGat
       {{70, 0, 40, 10}, 0.3f},                             // runs past the right border
   };
   const cv::Size size(100, 60);
-  auto map = CalibratedProbabilityMap(boxes, size, calibration);
+  // No superpixels (a crop of size 0): every pixel lies outside them, so a box holds all of its
+  // segment and paints its whole area.
+  auto map = CalibratedProbabilityMap(boxes, size, calibration, Superpixels{}, Box{});
   ASSERT_TRUE(map.ok()) << map.status().message();
   // Reference: for every pixel, the box with the largest F over it.
   for (int y = 0; y < size.height; ++y)
@@ -108,10 +110,66 @@ TEST(CalibratedProbabilityMap, EachPixelHoldsTheCalibratedScoreOfItsStrongestGat
 }
 
 TEST(CalibratedProbabilityMap, RefusesAnUnfittedCalibration) {
-  const auto map = CalibratedProbabilityMap({{{0, 0, 4, 4}, 0.5f}}, {8, 8}, ObstacleCalibration{});
+  const auto map = CalibratedProbabilityMap({{{0, 0, 4, 4}, 0.5f}}, {8, 8}, ObstacleCalibration{},
+                                            Superpixels{}, Box{});
   ASSERT_FALSE(map.ok());
   EXPECT_EQ(map.status().code(), StatusCode::kFailedPrecondition);
 }
 
+// A 40 x 20 crop at (10, 5) of a 60 x 40 frame: superpixel 1 (the "road") is everything but a
+// 6 x 4 block, superpixel 2 (the "obstacle"), framed by a 1-pixel boundary (label 0).
+Superpixels RoadWithOneObstacle() {
+  Superpixels sp;
+  sp.count = 2;
+  sp.labels = cv::Mat1i(20, 40, 1);
+  sp.labels(cv::Rect(19, 7, 8, 6)).setTo(0);
+  sp.labels(cv::Rect(20, 8, 6, 4)).setTo(2);
+  return sp;
+}
+
+TEST(CalibratedProbabilityMap, WeightsEachPixelByTheShareOfItsSuperpixelInTheBox) {
+  ObstacleCalibration calibration;
+  calibration.fitted = true;
+  calibration.slope = 4.0;
+  calibration.intercept = -2.0;
+  const Superpixels sp = RoadWithOneObstacle();
+  const Box crop{10, 5, 40, 20};
+  // The box frames the obstacle (frame 30..35 x 13..16) with a margin of road around it.
+  const Box box{27, 10, 12, 10};
+  auto map = CalibratedProbabilityMap({{box, 0.8f}}, {60, 40}, calibration, sp, crop);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  const float p = static_cast<float>(CalibratedScore(calibration, 0.8));
+  int road_in_box = 0;
+  for (int y = box.y; y < box.bottom(); ++y)
+    for (int x = box.x; x < box.right(); ++x) road_in_box += sp.labels(y - crop.y, x - crop.x) == 1;
+  const float road_share =
+      static_cast<float>(road_in_box) / static_cast<float>(cv::countNonZero(sp.labels == 1));
+  EXPECT_FLOAT_EQ((*map)(14, 32), p);               // obstacle: its superpixel is all inside
+  EXPECT_FLOAT_EQ((*map)(13, 29), p);               // its contour (label 0) takes its share
+  EXPECT_FLOAT_EQ((*map)(10, 27), p * road_share);  // the road in the corner: a small share
+  EXPECT_LT(road_share, 0.2f);
+  EXPECT_FLOAT_EQ((*map)(9, 27), 0.f);  // outside the box
+}
+
+TEST(CalibratedProbabilityMap, TakesTheLargestWeightedScoreOverThePixel) {
+  ObstacleCalibration calibration;
+  calibration.fitted = true;
+  calibration.slope = 4.0;
+  calibration.intercept = -2.0;
+  const Superpixels sp = RoadWithOneObstacle();
+  const Box crop{10, 5, 40, 20};
+  // A strong box holding most of the road, and a weaker one framing only the obstacle.
+  const Box road_box{10, 5, 40, 20}, obstacle_box{29, 12, 8, 6};
+  auto map = CalibratedProbabilityMap({{obstacle_box, 0.5f}, {road_box, 0.9f}}, {60, 40},
+                                      calibration, sp, crop);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  // The road box holds all of both superpixels, so it wins everywhere in it.
+  EXPECT_FLOAT_EQ((*map)(14, 32), static_cast<float>(CalibratedScore(calibration, 0.9)));
+  EXPECT_FLOAT_EQ((*map)(6, 12), static_cast<float>(CalibratedScore(calibration, 0.9)));
+  // Outside the crop the box's own score: no superpixel to share.
+  auto outside = CalibratedProbabilityMap({{{0, 30, 5, 5}, 0.5f}}, {60, 40}, calibration, sp, crop);
+  ASSERT_TRUE(outside.ok());
+  EXPECT_FLOAT_EQ((*outside)(32, 2), static_cast<float>(CalibratedScore(calibration, 0.5)));
+}
 }  // namespace
 }  // namespace tod
