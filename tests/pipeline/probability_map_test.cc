@@ -117,59 +117,78 @@ TEST(CalibratedProbabilityMap, RefusesAnUnfittedCalibration) {
 }
 
 // A 40 x 20 crop at (10, 5) of a 60 x 40 frame: superpixel 1 (the "road") is everything but a
-// 6 x 4 block, superpixel 2 (the "obstacle"), framed by a 1-pixel boundary (label 0).
-Superpixels RoadWithOneObstacle() {
-  Superpixels sp;
-  sp.count = 2;
-  sp.labels = cv::Mat1i(20, 40, 1);
-  sp.labels(cv::Rect(19, 7, 8, 6)).setTo(0);
-  sp.labels(cv::Rect(20, 8, 6, 4)).setTo(2);
-  return sp;
-}
+// 6 x 4 block, superpixel 2 (the "obstacle", frame 30..35 x 13..16), framed by a 1-pixel
+// boundary (label 0).
+class SuperpixelShareMapTest : public ::testing::Test {
+ protected:
+  SuperpixelShareMapTest() {
+    calibration_.fitted = true;
+    calibration_.slope = 4.0;
+    calibration_.intercept = -2.0;
+    superpixels_.count = 2;
+    superpixels_.labels = cv::Mat1i(20, 40, 1);
+    superpixels_.labels(cv::Rect(19, 7, 8, 6)).setTo(0);
+    superpixels_.labels(cv::Rect(20, 8, 6, 4)).setTo(2);
+  }
+  cv::Mat1f Map(const std::vector<ScoredBox>& boxes) const {
+    auto map = CalibratedProbabilityMap(boxes, {60, 40}, calibration_, superpixels_, crop_);
+    EXPECT_TRUE(map.ok()) << map.status().message();
+    return map.ok() ? *map : cv::Mat1f();
+  }
+  float Calibrated(float fused) const {
+    return static_cast<float>(CalibratedScore(calibration_, fused));
+  }
 
-TEST(CalibratedProbabilityMap, WeightsEachPixelByTheShareOfItsSuperpixelInTheBox) {
-  ObstacleCalibration calibration;
-  calibration.fitted = true;
-  calibration.slope = 4.0;
-  calibration.intercept = -2.0;
-  const Superpixels sp = RoadWithOneObstacle();
-  const Box crop{10, 5, 40, 20};
-  // The box frames the obstacle (frame 30..35 x 13..16) with a margin of road around it.
-  const Box box{27, 10, 12, 10};
-  auto map = CalibratedProbabilityMap({{box, 0.8f}}, {60, 40}, calibration, sp, crop);
-  ASSERT_TRUE(map.ok()) << map.status().message();
-  const float p = static_cast<float>(CalibratedScore(calibration, 0.8));
+  ObstacleCalibration calibration_;
+  Superpixels superpixels_;
+  const Box crop_{10, 5, 40, 20};
+};
+
+TEST_F(SuperpixelShareMapTest, WeightsEachPixelByTheShareOfItsSuperpixelInTheBox) {
+  const Box box{27, 10, 12, 10};  // frames the obstacle with a margin of road around it
+  const cv::Mat1f map = Map({{box, 0.8f}});
+  ASSERT_FALSE(map.empty());
   int road_in_box = 0;
   for (int y = box.y; y < box.bottom(); ++y)
-    for (int x = box.x; x < box.right(); ++x) road_in_box += sp.labels(y - crop.y, x - crop.x) == 1;
-  const float road_share =
-      static_cast<float>(road_in_box) / static_cast<float>(cv::countNonZero(sp.labels == 1));
-  EXPECT_FLOAT_EQ((*map)(14, 32), p);               // obstacle: its superpixel is all inside
-  EXPECT_FLOAT_EQ((*map)(13, 29), p);               // its contour (label 0) takes its share
-  EXPECT_FLOAT_EQ((*map)(10, 27), p * road_share);  // the road in the corner: a small share
+    for (int x = box.x; x < box.right(); ++x)
+      road_in_box += superpixels_.labels(y - crop_.y, x - crop_.x) == 1;
+  const float road_share = static_cast<float>(road_in_box) /
+                           static_cast<float>(cv::countNonZero(superpixels_.labels == 1));
+  const float p = Calibrated(0.8f);
+  EXPECT_FLOAT_EQ(map(14, 32), p);               // obstacle: its superpixel is all inside
+  EXPECT_FLOAT_EQ(map(13, 29), p);               // its contour (label 0) takes its share
+  EXPECT_FLOAT_EQ(map(10, 27), p * road_share);  // the road in the corner: a small share
   EXPECT_LT(road_share, 0.2f);
-  EXPECT_FLOAT_EQ((*map)(9, 27), 0.f);  // outside the box
+  EXPECT_FLOAT_EQ(map(9, 27), 0.f);  // outside the box
 }
 
-TEST(CalibratedProbabilityMap, TakesTheLargestWeightedScoreOverThePixel) {
-  ObstacleCalibration calibration;
-  calibration.fitted = true;
-  calibration.slope = 4.0;
-  calibration.intercept = -2.0;
-  const Superpixels sp = RoadWithOneObstacle();
-  const Box crop{10, 5, 40, 20};
-  // A strong box holding most of the road, and a weaker one framing only the obstacle.
-  const Box road_box{10, 5, 40, 20}, obstacle_box{29, 12, 8, 6};
-  auto map = CalibratedProbabilityMap({{obstacle_box, 0.5f}, {road_box, 0.9f}}, {60, 40},
-                                      calibration, sp, crop);
-  ASSERT_TRUE(map.ok()) << map.status().message();
-  // The road box holds all of both superpixels, so it wins everywhere in it.
-  EXPECT_FLOAT_EQ((*map)(14, 32), static_cast<float>(CalibratedScore(calibration, 0.9)));
-  EXPECT_FLOAT_EQ((*map)(6, 12), static_cast<float>(CalibratedScore(calibration, 0.9)));
-  // Outside the crop the box's own score: no superpixel to share.
-  auto outside = CalibratedProbabilityMap({{{0, 30, 5, 5}, 0.5f}}, {60, 40}, calibration, sp, crop);
-  ASSERT_TRUE(outside.ok());
-  EXPECT_FLOAT_EQ((*outside)(32, 2), static_cast<float>(CalibratedScore(calibration, 0.5)));
+TEST_F(SuperpixelShareMapTest, TakesTheLargestWeightedScoreOverThePixel) {
+  // A weak box framing the obstacle, and a strong wide one over the top rows of the crop that
+  // holds most of the road but only the obstacle's first row (a quarter of it).
+  const Box obstacle_box{29, 12, 8, 6}, wide_box{10, 5, 40, 9};
+  const cv::Mat1f map = Map({{obstacle_box, 0.5f}, {wide_box, 0.9f}});
+  ASSERT_FALSE(map.empty());
+  const float road_area = static_cast<float>(cv::countNonZero(superpixels_.labels == 1));
+  auto road_share = [&](const Box& b) {
+    const Box on_crop = Intersect(b, crop_);
+    const cv::Rect local(on_crop.x - crop_.x, on_crop.y - crop_.y, on_crop.w, on_crop.h);
+    return static_cast<float>(cv::countNonZero(superpixels_.labels(local) == 1)) / road_area;
+  };
+  // The obstacle's first row, in both boxes: the weak box holds all of it and wins.
+  ASSERT_GT(Calibrated(0.5f), 0.25f * Calibrated(0.9f));
+  EXPECT_FLOAT_EQ(map(13, 32), Calibrated(0.5f));
+  EXPECT_FLOAT_EQ(map(14, 32), Calibrated(0.5f));  // only in the weak box
+  // Road in both boxes: the larger weighted score, which is the wide box's larger share.
+  ASSERT_GT(Calibrated(0.9f) * road_share(wide_box), Calibrated(0.5f) * road_share(obstacle_box));
+  EXPECT_FLOAT_EQ(map(12, 29), Calibrated(0.9f) * road_share(wide_box));
+  EXPECT_FLOAT_EQ(map(17, 29), Calibrated(0.5f) * road_share(obstacle_box));  // weak box only
 }
+
+TEST_F(SuperpixelShareMapTest, PixelsOutsideTheCropTakeTheBoxScore) {
+  const cv::Mat1f map = Map({{{0, 30, 5, 5}, 0.5f}});
+  ASSERT_FALSE(map.empty());
+  EXPECT_FLOAT_EQ(map(32, 2), Calibrated(0.5f));
+}
+
 }  // namespace
 }  // namespace tod
