@@ -99,11 +99,12 @@ Status ValidateSelectionInput(const Sample& gt, const std::vector<int>& range_li
 
 ProposalCategory CategorizeProposal(const Box& box, const MaskIoUTable& obstacles,
                                     const MaskPixelCounter& road,
+                                    const MaskPixelCounter& void_pixels,
                                     const SampleSelectionParams& params) {
   if (obstacles.MaxIoU(box) >= params.obstacle_iou) return ProposalCategory::kObstacle;
-  const long long area = box.area();
-  if (area > 0 &&
-      static_cast<double>(road.Count(box)) / static_cast<double>(area) > params.road_fraction) {
+  const long long scored = box.area() - void_pixels.Count(box);
+  if (scored > 0 &&
+      static_cast<double>(road.Count(box)) / static_cast<double>(scored) > params.road_fraction) {
     return ProposalCategory::kRoad;
   }
   return ProposalCategory::kBackground;
@@ -130,6 +131,8 @@ Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& prop
   }
   const MaskIoUTable& obstacles = *table;
   const MaskPixelCounter road(gt.road);
+  const MaskPixelCounter void_pixels =
+      gt.ignore.empty() ? MaskPixelCounter() : MaskPixelCounter(gt.ignore);
   const int num_proposals = static_cast<int>(proposals.size());
 
   std::vector<double> max_iou(num_proposals);
@@ -138,7 +141,7 @@ Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& prop
   for (int i = 0; i < num_proposals; ++i) {
     const Box& box = proposals[i].box;
     max_iou[i] = obstacles.MaxIoU(box);
-    category[i] = CategorizeProposal(box, obstacles, road, params);
+    category[i] = CategorizeProposal(box, obstacles, road, void_pixels, params);
     range[i] = VerticalRangeIndex(BottomRow(box), range_limits);
   }
 

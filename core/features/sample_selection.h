@@ -28,9 +28,13 @@ struct SampleSelectionParams {
 enum class ProposalCategory { kRoad, kObstacle, kBackground };
 
 // The category of §4.3 [R]: obstacle if max mask IoU >= obstacle_iou; else road if more than
-// road_fraction of the box's w·h pixels are road; else background.
+// road_fraction of the box's scored pixels (its w·h pixels less the void ones, `void_pixels`)
+// are road; else background. Void is neither road nor background (§3.4): counted as "not road"
+// it made every box over the void ground beside a road (Fishyscapes' 255) a background box, which
+// sets without a road label never draw as negatives. A box with no scored pixel is background.
 ProposalCategory CategorizeProposal(const Box& box, const MaskIoUTable& obstacles,
                                     const MaskPixelCounter& road,
+                                    const MaskPixelCounter& void_pixels,
                                     const SampleSelectionParams& params);
 
 // Index k (0-based, 0 = V_1 = nearest, bottom of the image) of the vertical range containing

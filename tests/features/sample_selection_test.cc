@@ -49,7 +49,9 @@ TEST(CategoryTest, ObstacleRoadBackground) {
   ASSERT_TRUE(table.ok());
   const MaskPixelCounter road(sample.road);
   const SampleSelectionParams params;
-  auto category = [&](const Box& b) { return CategorizeProposal(b, *table, road, params); };
+  auto category = [&](const Box& b) {
+    return CategorizeProposal(b, *table, road, MaskPixelCounter(), params);
+  };
   EXPECT_EQ(category({40, 70, 10, 10}), ProposalCategory::kObstacle);
   EXPECT_EQ(category({40, 70, 10, 5}), ProposalCategory::kObstacle);  // IoU 50/100 = 0.5
   // IoU 0.4 and no road: obstacle pixels are not road pixels.
@@ -62,6 +64,28 @@ TEST(CategoryTest, ObstacleRoadBackground) {
   EXPECT_EQ(category({35, 70, 20, 10}), ProposalCategory::kObstacle);
   // 30x10 box around it: IoU 100 / 300, road 200 of 300 -> road.
   EXPECT_EQ(category({30, 70, 30, 10}), ProposalCategory::kRoad);
+}
+
+// Void is neither road nor background: the road share is taken over a box's scored pixels.
+TEST(CategoryTest, VoidPixelsAreNotCounted) {
+  const Sample sample = RoadWithOneObstacle();
+  auto table = MaskIoUTable::Build(sample.instances);
+  ASSERT_TRUE(table.ok());
+  const MaskPixelCounter road(sample.road);
+  cv::Mat1b void_mask(100, 100, uchar{0});
+  void_mask(cv::Rect(0, 0, 100, 50)).setTo(255);  // the upper half, beside the road, is void
+  const MaskPixelCounter void_pixels(void_mask);
+  const SampleSelectionParams params;
+  auto category = [&](const Box& b, const MaskPixelCounter& v) {
+    return CategorizeProposal(b, *table, road, v, params);
+  };
+  // 30 % road, 70 % void: every scored pixel is road.
+  EXPECT_EQ(category({0, 43, 10, 10}, MaskPixelCounter()), ProposalCategory::kBackground);
+  EXPECT_EQ(category({0, 43, 10, 10}, void_pixels), ProposalCategory::kRoad);
+  // All void: nothing scored, background (never drawn as a road negative).
+  EXPECT_EQ(category({0, 10, 10, 10}, void_pixels), ProposalCategory::kBackground);
+  // The obstacle test does not change: IoU decides first.
+  EXPECT_EQ(category({40, 70, 10, 10}, void_pixels), ProposalCategory::kObstacle);
 }
 
 struct Scene {
@@ -153,12 +177,12 @@ TEST(SampleSelectionTest, NegativeCountsPerRangeAndHardEasySplit) {
   const std::set<int> positives(selected->positive_indices.begin(),
                                 selected->positive_indices.end());
   for (const int i : ordr) {
-    EXPECT_EQ(CategorizeProposal(scene.proposals[i].box, *table, road, params),
+    EXPECT_EQ(CategorizeProposal(scene.proposals[i].box, *table, road, MaskPixelCounter(), params),
               ProposalCategory::kRoad);
     EXPECT_FALSE(positives.count(i));
   }
   for (const int i : obdr) {
-    EXPECT_EQ(CategorizeProposal(scene.proposals[i].box, *table, road, params),
+    EXPECT_EQ(CategorizeProposal(scene.proposals[i].box, *table, road, MaskPixelCounter(), params),
               ProposalCategory::kBackground);
   }
   EXPECT_EQ(std::set<int>(ordr.begin(), ordr.end()).size(), ordr.size());
