@@ -22,8 +22,9 @@ enum class MapKind {
   // The paper's map (§7): the top half of the boxes summed, divided by the frame's maximum. Its
   // peak is 1 on every frame; the paper's metrics are defined on it.
   kNormalized,
-  // Per pixel, the calibrated score of the strongest fused box over it (probability_map.h):
-  // comparable across frames, so a threshold means the same on an empty road and a busy one.
+  // Per pixel, the largest calibrated score of the fused boxes over it, each weighted by the share
+  // of the pixel's superpixel the box holds (probability_map.h): comparable across frames, so a
+  // threshold means the same on an empty road and a busy one.
   kCalibrated,
 };
 // "normalized" / "calibrated", the name the REST query, the CLI and the JSON use.
