@@ -64,6 +64,10 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_flag("--refine-all", args->refine_all,
                 "refine every scoring window, as the paper (default: the 5000 best grid local "
                 "maxima per region)");
+  cmd->add_flag("--mine-hard-negatives", args->train.mine_hard_negatives,
+                "train the regressors twice, the second time with the first round's best-scored "
+                "non-obstacles as hard negatives (default: one round, hard negatives by "
+                "objectness, as the paper)");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,

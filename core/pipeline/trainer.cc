@@ -10,6 +10,7 @@
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/parallel.h"
+#include "core/pipeline/probability_map.h"
 
 namespace tod {
 namespace {
@@ -284,8 +285,12 @@ struct RegressorSamples {
   long long proposals = 0;
 };
 
+// With `miner` (a bundle with trained regressors), the negatives' "hard" share is drawn from the
+// proposals the miner's fused score puts above selection.hard_objectness instead of by
+// objectness (TrainOptions::mine_hard_negatives).
 Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey& survey,
-                                                 const ModelBundle& bundle) {
+                                                 const ModelBundle& bundle,
+                                                 const ModelBundle* miner = nullptr) {
   const TrainOptions& options = run.options();
   const int n = run.num_frames();
   RegressorSamples out;
@@ -304,8 +309,16 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
                            DetectorProposalOptions(bundle.params, bundle.regions.num_layers()),
                            bundle.size_filter);
           proposals[i] = static_cast<long long>(all.boxes.size());
+          std::vector<ScoredBox> ranked = all.boxes;  // scored by objectness
+          if (miner != nullptr) {
+            const RegressedProposals scored =
+                RegressProposals(*miner, s.image, oaocc, bundle.regions, all);
+            const std::vector<float> fused =
+                FuseScores(scored.ordr, scored.obdr, bundle.params.fusion);
+            for (std::size_t j = 0; j < ranked.size(); ++j) ranked[j].score = fused[j];
+          }
           auto selected =
-              SelectTrainingSamples(all.boxes, s, limits, options.selection,
+              SelectTrainingSamples(ranked, s, limits, options.selection,
                                     options.seed * 1000003ULL + static_cast<unsigned>(i));
           if (!selected.ok()) return selected.status();
           out.ordr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
@@ -485,6 +498,21 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   auto regressors = TrainRegressorPair(
       *samples, [](int) { return true; }, RegressorForest(options));
   if (!regressors.ok()) return regressors.status().WithContext("training the regressors");
+  run.EndStep("regressors");
+  if (options.mine_hard_negatives) {
+    run.StartStep();
+    run.Say("mining hard negatives with the first-round regressors");
+    ModelBundle miner = bundle;
+    miner.ordr = std::move(regressors->ordr);
+    miner.obdr = std::move(regressors->obdr);
+    samples = CollectRegressorSamples(run, *survey, bundle, &miner);
+    if (!samples.ok()) return samples.status().WithContext("mining hard negatives");
+    run.Say("training ORDR and OBDR on the mined samples");
+    regressors = TrainRegressorPair(
+        *samples, [](int) { return true; }, RegressorForest(options));
+    if (!regressors.ok()) return regressors.status().WithContext("training the regressors");
+    run.EndStep("hard_negatives");
+  }
   bundle.ordr = std::move(regressors->ordr);
   bundle.obdr = std::move(regressors->obdr);
   const ForestParams forest = RegressorForest(options);
@@ -495,8 +523,8 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
                                                            : regressors->obdr_samples},
                    {"trees", forest.num_trees},
                    {"mtry", forest.max_features},
-                   {"min_leaf", forest.min_leaf_size}};
-  run.EndStep("regressors");
+                   {"min_leaf", forest.min_leaf_size},
+                   {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"}};
 
   run.StartStep();
   run.Say("calibrating obstacle scores (2-fold)");

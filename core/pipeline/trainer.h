@@ -42,6 +42,11 @@ struct TrainOptions {
   OcclusionParams occlusion_params;
   ForestParams regressor{.num_trees = 200, .max_features = 6, .min_leaf_size = 5};
   SampleSelectionParams selection;
+  // Bootstrapping (not in the paper; off by default, README "Real frames"): after a first
+  // training round, sample the regressors' negatives again, taking the "hard" share
+  // (selection.hard_fraction) from the proposals the first round's regressors score above
+  // selection.hard_objectness (fused score) instead of by objectness, and train again.
+  bool mine_hard_negatives = false;
   std::function<void(const std::string&)> progress;  // one line per step
 };
 

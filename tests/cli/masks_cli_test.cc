@@ -88,6 +88,7 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
   EXPECT_EQ(manifest["training"]["format"], "masks");
   for (const char* part : {"edges", "occlusion", "ordr", "obdr", "calibration"})
     EXPECT_EQ(manifest["training"]["parts"][part]["trained"], true) << part;
+  EXPECT_EQ(manifest["training"]["parts"]["ordr"]["hard_negatives"], "objectness");
   EXPECT_TRUE(manifest["params"]["obstacle_calibration"]["fitted"].get<bool>());
   EXPECT_LT(manifest["params"]["prior_correction"]["occlusion_odds"].get<double>(), 1.0);
 
@@ -115,6 +116,31 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
                                            " --split test --model " + model + " --threads 2");
   ASSERT_EQ(analyse.exit_code, 0) << analyse.output;
   EXPECT_NE(analyse.output.find("Where obstacles are lost"), std::string::npos);
+}
+
+// --mine-hard-negatives trains the regressors a second time on negatives the first round scored
+// highest; the manifest says so, and the forests differ from the single round's (same seed).
+TEST_F(MasksCliTest, HardNegativeMiningIsOptInAndRecorded) {
+  const std::string plain = (out_ / "plain").string(), mined = (out_ / "mined").string();
+  const CommandResult plain_run = RunCommand(Train(plain));
+  ASSERT_EQ(plain_run.exit_code, 0) << plain_run.output;
+  EXPECT_EQ(plain_run.output.find("mining hard negatives"), std::string::npos);
+  const CommandResult mined_run = RunCommand(Train(mined, "--mine-hard-negatives"));
+  ASSERT_EQ(mined_run.exit_code, 0) << mined_run.output;
+  EXPECT_NE(mined_run.output.find("mining hard negatives"), std::string::npos) << mined_run.output;
+  auto manifest = [](const std::string& model) {
+    std::ifstream in(fs::path(model) / "manifest.json");
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json p = manifest(plain), m = manifest(mined);
+  for (const char* part : {"ordr", "obdr"}) {
+    EXPECT_EQ(m["training"]["parts"][part]["hard_negatives"], "mined") << part;
+    EXPECT_EQ(m["training"]["parts"][part]["trained"], true) << part;
+    EXPECT_NE(m["files"][std::string(part) + ".bin"]["fnv1a64"],
+              p["files"][std::string(part) + ".bin"]["fnv1a64"])
+        << part;
+  }
+  EXPECT_TRUE(m["training"]["seconds"].contains("hard_negatives"));
 }
 
 TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
