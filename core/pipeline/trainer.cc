@@ -386,6 +386,47 @@ ForestParams RegressorForest(const TrainOptions& options) {
   return forest;
 }
 
+// The regressors and the samples they were trained on (kept for the calibration folds).
+struct TrainedRegressors {
+  RegressorSamples samples;
+  Regressors regressors;
+};
+
+// Samples, then ORDR and OBDR (§6); with TrainOptions::mine_hard_negatives a second round
+// (bootstrapping): the first round's regressors score every training proposal, the negatives
+// are drawn again with their hard share by that score, and the regressors train again.
+Result<TrainedRegressors> TrainRegressors(TrainingRun& run, const Survey& survey,
+                                          const ModelBundle& bundle) {
+  const TrainOptions& options = run.options();
+  run.StartStep();
+  auto samples = CollectRegressorSamples(run, survey, bundle);
+  if (!samples.ok()) return samples.status();
+  run.EndStep("proposals_and_samples");
+
+  run.StartStep();
+  run.Say("training ORDR and OBDR");
+  auto regressors = TrainRegressorPair(
+      *samples, [](int) { return true; }, RegressorForest(options));
+  if (!regressors.ok()) return regressors.status().WithContext("training the regressors");
+  run.EndStep("regressors");
+  if (!options.mine_hard_negatives)
+    return TrainedRegressors{std::move(*samples), std::move(*regressors)};
+
+  run.StartStep();
+  run.Say("mining hard negatives with the first-round regressors");
+  ModelBundle miner = bundle;
+  miner.ordr = std::move(regressors->ordr);
+  miner.obdr = std::move(regressors->obdr);
+  auto mined = CollectRegressorSamples(run, survey, bundle, &miner);
+  if (!mined.ok()) return mined.status().WithContext("mining hard negatives");
+  run.Say("training ORDR and OBDR on the mined samples");
+  auto second = TrainRegressorPair(
+      *mined, [](int) { return true; }, RegressorForest(options));
+  if (!second.ok()) return second.status().WithContext("training the regressors (second round)");
+  run.EndStep("hard_negatives");
+  return TrainedRegressors{std::move(*mined), std::move(*second)};
+}
+
 // Calibration of the obstacles' scores (obstacle_calibration.h). The regressors fit their own
 // training frames closely, so scores on those frames would be overconfident: each frame is
 // scored by regressors trained on the other fold of frames (2-fold cross-fitting), then Platt
@@ -488,39 +529,18 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   if (Status st = TrainOcclusionClassifier(run, *survey, bundle, parts); !st.ok()) return st;
   run.EndStep("occlusion");
 
-  run.StartStep();
-  auto samples = CollectRegressorSamples(run, *survey, bundle);
-  if (!samples.ok()) return samples.status();
-  run.EndStep("proposals_and_samples");
-
-  run.StartStep();
-  run.Say("training ORDR and OBDR");
-  auto regressors = TrainRegressorPair(
-      *samples, [](int) { return true; }, RegressorForest(options));
-  if (!regressors.ok()) return regressors.status().WithContext("training the regressors");
-  run.EndStep("regressors");
-  if (options.mine_hard_negatives) {
-    run.StartStep();
-    run.Say("mining hard negatives with the first-round regressors");
-    ModelBundle miner = bundle;
-    miner.ordr = std::move(regressors->ordr);
-    miner.obdr = std::move(regressors->obdr);
-    samples = CollectRegressorSamples(run, *survey, bundle, &miner);
-    if (!samples.ok()) return samples.status().WithContext("mining hard negatives");
-    run.Say("training ORDR and OBDR on the mined samples");
-    regressors = TrainRegressorPair(
-        *samples, [](int) { return true; }, RegressorForest(options));
-    if (!regressors.ok()) return regressors.status().WithContext("training the regressors");
-    run.EndStep("hard_negatives");
-  }
-  bundle.ordr = std::move(regressors->ordr);
-  bundle.obdr = std::move(regressors->obdr);
+  auto trained = TrainRegressors(run, *survey, bundle);
+  if (!trained.ok()) return trained.status();
+  bundle.ordr = std::move(trained->regressors.ordr);
+  bundle.obdr = std::move(trained->regressors.obdr);
+  const RegressorSamples& samples = trained->samples;
+  const Regressors& regressors = trained->regressors;  // its sample counts
   const ForestParams forest = RegressorForest(options);
   for (const char* name : {"ordr", "obdr"})
     parts[name] = {{"learned", true},
                    {"trained", true},
-                   {"samples", std::string(name) == "ordr" ? regressors->ordr_samples
-                                                           : regressors->obdr_samples},
+                   {"samples", std::string(name) == "ordr" ? regressors.ordr_samples
+                                                           : regressors.obdr_samples},
                    {"trees", forest.num_trees},
                    {"mtry", forest.max_features},
                    {"min_leaf", forest.min_leaf_size},
@@ -528,7 +548,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
 
   run.StartStep();
   run.Say("calibrating obstacle scores (2-fold)");
-  if (Status st = CalibrateObstacleScores(run, *survey, *samples, bundle, parts); !st.ok())
+  if (Status st = CalibrateObstacleScores(run, *survey, samples, bundle, parts); !st.ok())
     return st;
   run.EndStep("calibration");
 
@@ -548,9 +568,9 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
                      {"regions_from", options.regions},
                      {"seed", options.seed},
                      {"classifier_frames", ClassifierFrames(run, *survey).size()},
-                     {"mean_proposals_per_frame", static_cast<double>(samples->proposals) / n},
-                     {"ordr_samples", regressors->ordr_samples},
-                     {"obdr_samples", regressors->obdr_samples},
+                     {"mean_proposals_per_frame", static_cast<double>(samples.proposals) / n},
+                     {"ordr_samples", regressors.ordr_samples},
+                     {"obdr_samples", regressors.obdr_samples},
                      {"parts", parts},
                      {"regressor",
                       {{"trees", forest.num_trees},
