@@ -11,6 +11,7 @@
 
 #include "core/modd2/mat5_bounds.h"
 #include "core/modd2/modd2_reader.h"
+#include "tests/data/temp_dir.h"
 #include "tests/modd2/mat_fixture.h"
 #include "tests/test_env.h"
 
@@ -94,16 +95,16 @@ TEST(Mat5BoundsTest, MatV4HeaderClaimingAHugeNameIsRefused) {
   fs::remove(path);
 }
 
+// Each test writes its own file: ctest runs the tests of this fixture in parallel processes, and a
+// shared name let one test's TearDown remove the file another was reading.
 class Mat5BoundsFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    path_ = (fs::path(::testing::TempDir()) / "mat5_bounds.mat").string();
+    path_ = (scratch_.path() / "mat5_bounds.mat").string();
     ASSERT_TRUE(modd2_test::WriteAnnotation(path_, {{1, 20}, {64, 22}}, {{10, 30, 8, 6}},
                                             MAT_COMPRESSION_NONE));
     bytes_ = ReadAll(path_);
   }
-  void TearDown() override { fs::remove(path_); }
-
   // Byte offset of the first dimensions subelement after `from` (tag miINT32, 8 bytes).
   size_t DimsAfter(size_t from) const {
     const std::string tag("\x05\0\0\0\x08\0\0\0", 8);
@@ -112,6 +113,7 @@ class Mat5BoundsFileTest : public ::testing::Test {
     return at + 8;
   }
 
+  tod::testing::TempDir scratch_;
   std::string path_;
   std::string bytes_;
 };
