@@ -54,6 +54,10 @@ Runner AddTrainCommand(CLI::App& app) {
                   "fail: stop at an unreadable frame; skip: leave it out, list and count it")
       ->check(CLI::IsMember({"fail", "skip"}));
   cmd->add_flag("--no-size-filter", args->no_size_filter, "switch the box size filter off");
+  cmd->add_option("--size-filter-recipe", args->train.size_filter_recipe,
+                  "size filter ranges: ground_plane (every obstacle's size per row below a fitted "
+                  "horizon, default) or bands (the authors' per-band min / max)")
+      ->check(CLI::IsMember({"ground_plane", "bands"}));
   bool* correct = &args->train.prior_correction;
   cmd->add_flag_callback(
       "--no-prior-correction", [correct] { *correct = false; },

@@ -11,6 +11,7 @@
 #include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/parallel.h"
 #include "core/pipeline/probability_map.h"
+#include "core/proposals/ground_plane_size_prior.h"
 
 namespace tod {
 namespace {
@@ -135,14 +136,50 @@ Result<Survey> SurveyFrames(TrainingRun& run) {
   return survey;
 }
 
+// The size filter of `--regions auto` bundles: the ground-plane prior (ours, README "Real
+// frames") or the authors' per-band extremes (§4.3). Recorded in parts["size_filter"].
+Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
+                        nlohmann::json& parts) {
+  const std::string& recipe = run.options().size_filter_recipe;
+  if (recipe == "bands") {
+    bundle.size_filter = SizeFilter::Derive(survey.obstacle_boxes);
+    parts["size_filter"] = {{"recipe", "bands"}, {"obstacles", survey.obstacle_boxes.size()}};
+    return Status::Ok();
+  }
+  if (recipe != "ground_plane")
+    return Status::InvalidArgument("--size-filter-recipe must be ground_plane or bands, got '" +
+                                   recipe + "'");
+  const auto prior = FitGroundPlaneSizePrior(survey.obstacle_boxes);
+  if (!prior.ok())
+    return prior.status().WithContext(
+        "fitting the size filter's ground-plane prior (too few "
+        "obstacles? --size-filter-recipe bands needs none)");
+  bundle.size_filter = GroundPlaneSizeFilter(*prior, survey.obstacle_boxes);
+  parts["size_filter"] = {{"recipe", "ground_plane"},
+                          {"obstacles", prior->obstacles},
+                          {"horizon_y", prior->horizon_y},
+                          {"h_per_row", {prior->h_ratio_min, prior->h_ratio_max}},
+                          {"w_per_row", {prior->w_ratio_min, prior->w_ratio_max}},
+                          {"area_per_row2", {prior->area_ratio_min, prior->area_ratio_max}}};
+  char line[128];
+  std::snprintf(line, sizeof line, "size filter: horizon at row %.1f, h/d %.3f-%.3f, w/d %.3f-%.3f",
+                prior->horizon_y, prior->h_ratio_min, prior->h_ratio_max, prior->w_ratio_min,
+                prior->w_ratio_max);
+  run.Say(line);
+  return Status::Ok();
+}
+
 // Multilayer regions and the size filter from the training obstacles (§1.4, §4.3).
-Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundle) {
+Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
+                      nlohmann::json& parts) {
   const TrainOptions& options = run.options();
   if (options.regions == "laf2020") {
     bundle.regions = Laf2020Regions().ScaledTo(survey.width, survey.height);
     bundle.size_filter = SizeFilter::Laf2020();
-    if (survey.width != 2048 || survey.height != 1024)
-      bundle.size_filter = SizeFilter::Derive(survey.obstacle_boxes);
+    parts["size_filter"] = {{"recipe", "laf2020"}};
+    if (survey.width != 2048 || survey.height != 1024) {
+      if (Status st = DeriveSizeFilter(run, survey, bundle, parts); !st.ok()) return st;
+    }
   } else if (options.regions == "auto") {
     RegionParams region_params = options.params.regions;
     region_params.seed = options.seed;
@@ -150,7 +187,7 @@ Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundl
         DeriveMultilayerRegions(survey.footprints, survey.width, survey.height, region_params);
     if (!regions.ok()) return regions.status().WithContext("deriving the multilayer regions");
     bundle.regions = *regions;
-    bundle.size_filter = SizeFilter::Derive(survey.obstacle_boxes);
+    if (Status st = DeriveSizeFilter(run, survey, bundle, parts); !st.ok()) return st;
   } else {
     return Status::InvalidArgument("--regions must be auto or laf2020, got '" + options.regions +
                                    "'");
@@ -518,7 +555,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   run.StartStep();
   auto survey = SurveyFrames(run);
   if (!survey.ok()) return survey.status();
-  if (Status st = DeriveGeometry(run, *survey, bundle); !st.ok()) return st;
+  if (Status st = DeriveGeometry(run, *survey, bundle, parts); !st.ok()) return st;
   run.EndStep("survey");
 
   run.StartStep();

@@ -29,6 +29,10 @@ struct TrainOptions {
   std::vector<std::string> more_data;
   std::string data_terms;        // the training data's terms of use, recorded in the manifest
   std::string regions = "auto";  // auto (k-means on the training obstacles) | laf2020
+  // How the size filter's ranges come from the training obstacles: ground_plane (ours; pools
+  // every obstacle through h, w, area per row below a fitted horizon, ground_plane_size_prior.h)
+  // or bands (the authors' per-band min / max, §4.3).
+  std::string size_filter_recipe = "ground_plane";
   std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
   std::string sed_model;                     // model file for edge_source "sed"
   std::uint64_t seed = 1;

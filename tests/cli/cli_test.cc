@@ -52,7 +52,8 @@ TEST_F(CliTest, TrainWroteACompleteManifestWithItsOwnEvalNumbers) {
   const nlohmann::json m = nlohmann::json::parse(in);
   EXPECT_EQ(m["format_version"], 1);
   EXPECT_EQ(m["regions"]["layers"].size(), 4u);
-  EXPECT_EQ(m["size_filter"]["bands"].size(), 3u);
+  EXPECT_EQ(m["size_filter"]["bands"].size(), 8u);  // the ground-plane prior's bands
+  EXPECT_EQ(m["training"]["parts"]["size_filter"]["recipe"], "ground_plane");
   EXPECT_EQ(m["edge_source"], "pixel_forest");
   EXPECT_TRUE(m["params"].contains("boxes"));
   EXPECT_EQ(m["params"]["boxes"]["refine_local_maxima"], true);  // the default refinement

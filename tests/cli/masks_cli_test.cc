@@ -89,6 +89,10 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
   for (const char* part : {"edges", "occlusion", "ordr", "obdr", "calibration"})
     EXPECT_EQ(manifest["training"]["parts"][part]["trained"], true) << part;
   EXPECT_EQ(manifest["training"]["parts"]["ordr"]["hard_negatives"], "objectness");
+  const nlohmann::json& size_filter = manifest["training"]["parts"]["size_filter"];
+  EXPECT_EQ(size_filter["recipe"], "ground_plane") << size_filter.dump();
+  EXPECT_TRUE(size_filter["horizon_y"].is_number()) << size_filter.dump();
+  EXPECT_EQ(manifest["size_filter"]["bands"].size(), 8u);
   EXPECT_TRUE(manifest["params"]["obstacle_calibration"]["fitted"].get<bool>());
   EXPECT_LT(manifest["params"]["prior_correction"]["occlusion_odds"].get<double>(), 1.0);
 
@@ -141,6 +145,24 @@ TEST_F(MasksCliTest, HardNegativeMiningIsOptInAndRecorded) {
         << part;
   }
   EXPECT_TRUE(m["training"]["seconds"].contains("hard_negatives"));
+}
+
+// --size-filter-recipe bands restores the authors' per-band extremes (three bands); the manifest
+// names the recipe, and an unknown recipe is refused before any work.
+TEST_F(MasksCliTest, SizeFilterRecipeIsAChoiceAndRecorded) {
+  const std::string model = (out_ / "bands").string();
+  const CommandResult run = RunCommand(Train(model, "--size-filter-recipe bands"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(run.output.find("horizon at row"), std::string::npos) << run.output;
+  std::ifstream in(fs::path(model) / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(in);
+  EXPECT_EQ(manifest["training"]["parts"]["size_filter"]["recipe"], "bands");
+  EXPECT_EQ(manifest["size_filter"]["bands"].size(), 3u);
+  const CommandResult wrong =
+      RunCommand(Train((out_ / "wrong").string(), "--size-filter-recipe everything"));
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_NE(wrong.output.find("size-filter-recipe"), std::string::npos) << wrong.output;
+  EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
 }
 
 TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
