@@ -72,6 +72,12 @@ Runner AddTrainCommand(CLI::App& app) {
                 "train the regressors twice, the second time with the first round's best-scored "
                 "non-obstacles as hard negatives (default: one round, hard negatives by "
                 "objectness, as the paper)");
+  bool* out_of_fold = &args->train.out_of_fold_maps;
+  cmd->add_flag_callback(
+      "--in-sample-maps", [out_of_fold] { *out_of_fold = false; },
+      "train each learned part on maps of the final classifiers, which have seen those frames "
+      "(the paper's training; default: maps from classifiers trained on the other of two folds "
+      "of frames, as a new frame's)");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,

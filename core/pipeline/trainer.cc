@@ -1,5 +1,6 @@
 #include "core/pipeline/trainer.h"
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -211,14 +212,69 @@ std::vector<int> ClassifierFrames(const TrainingRun& run, const Survey& survey) 
   return out;
 }
 
+// Out-of-fold maps (TrainOptions::out_of_fold_maps). The edge and occlusion classifiers fit the
+// frames they were trained on far better than a frame they have never seen, so maps computed on
+// training frames with them are cleaner than any test frame's, and whatever learns from those
+// maps (the occlusion classifier from edge maps, the regressors from occlusion maps and edge
+// features) learns from the wrong distribution. Stacked training: each learned part also gets a
+// copy trained on each of two folds of frames, and a frame's maps for the next part come from the
+// copy trained on the other fold, as they would on a frame never seen.
+constexpr int kFolds = 2;
+
+constexpr char kFewFramesHint[] =
+    "out-of-fold maps train each classifier again on each half of the classifier frames; with "
+    "few frames, --in-sample-maps trains without the halves";
+
+struct ClassifierFolds {
+  bool enabled = false;
+  // Fold of every frame position. The classifier frames alternate between the folds in their own
+  // order (they are every k-th usable frame, so position parity could put them all in one fold);
+  // the other usable frames, which no classifier saw, alternate in theirs.
+  std::vector<int> fold_of;
+  // upstream[f]: the bundle's parameters with the classifiers trained on fold f's frames.
+  std::array<ModelBundle, kFolds> upstream;
+
+  ClassifierFolds(bool on, int num_frames, const std::vector<int>& usable,
+                  const std::vector<int>& classifier_frames)
+      : enabled(on), fold_of(num_frames, -1) {
+    int next = 0;
+    for (int i : classifier_frames) fold_of[i] = next++ % kFolds;
+    next = 0;
+    for (int i : usable)
+      if (fold_of[i] < 0) fold_of[i] = next++ % kFolds;
+  }
+  int FoldOf(int frame) const { return fold_of[frame]; }
+  // The bundle whose classifiers compute frame `i`'s maps for a downstream part.
+  const ModelBundle& For(const ModelBundle& bundle, int frame) const {
+    return enabled ? upstream[(FoldOf(frame) + 1) % kFolds] : bundle;
+  }
+  // The positions in `which` that lie in `fold`.
+  std::vector<int> InFold(const std::vector<int>& which, int fold) const {
+    std::vector<int> out;
+    for (int i : which)
+      if (FoldOf(i) == fold) out.push_back(i);
+    return out;
+  }
+};
+
+// An edge source that is not learned has seen no frame: every fold uses it as it is.
+void ShareUnlearnedEdges(const ModelBundle& bundle, ClassifierFolds& folds) {
+  for (ModelBundle& upstream : folds.upstream) {
+    upstream.edge_kind = bundle.edge_kind;
+    upstream.edges = bundle.edges;
+    upstream.params.prior_correction.edge_odds = bundle.params.prior_correction.edge_odds;
+  }
+}
+
 // §3.4 step 1: the base edge source. Samples are extracted frame by frame.
 Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
-                       nlohmann::json& parts) {
+                       ClassifierFolds& folds, nlohmann::json& parts) {
   const TrainOptions& options = run.options();
   bundle.edge_kind = options.edge_source;
   if (options.edge_source == "gradient") {
     bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
     parts["edges"] = {{"kind", "gradient"}, {"learned", false}};
+    ShareUnlearnedEdges(bundle, folds);
     return Status::Ok();
   }
   if (options.edge_source == "sed") {
@@ -226,6 +282,7 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
     if (!sed.ok()) return sed.status().WithContext("loading the SED edge model");
     bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
     parts["edges"] = {{"kind", "sed"}, {"learned", false}, {"model", options.sed_model}};
+    ShareUnlearnedEdges(bundle, folds);
     return Status::Ok();
   }
   if (options.edge_source != "pixel_forest")
@@ -246,29 +303,42 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
     return Status::Ok();
   }));
   if (!st.ok()) return st.WithContext("pixel edge classifier");
-  EdgeSamples all;
-  for (const EdgeSamples& f : per_frame) AppendEdgeSamples(all, f);
-  per_frame.clear();
-  run.Say("training the pixel edge classifier on " + std::to_string(all.targets.size()) +
-          " samples");
-  auto classifier = PixelEdgeClassifier::TrainOnSamples(all, edge_params);
-  if (!classifier.ok())
-    return classifier.status().WithContext("training the pixel edge classifier");
-  bundle.params.prior_correction.edge_odds =
-      options.prior_correction ? classifier->sampled_odds_scale() : 1.0;
-  parts["edges"] = {{"kind", "pixel_forest"},
-                    {"learned", true},
-                    {"trained", true},
-                    {"frames", which.size()},
-                    {"samples", all.targets.size()},
-                    {"prior_odds", bundle.params.prior_correction.edge_odds}};
+  std::size_t samples = 0;
+  const auto fit = [&](const std::vector<int>& frames,
+                       const std::string& name) -> Result<PixelEdgeClassifier> {
+    EdgeSamples all;
+    for (int i : frames) AppendEdgeSamples(all, per_frame[i]);
+    samples = all.targets.size();
+    run.Say("training the " + name + " on " + std::to_string(all.targets.size()) + " samples");
+    auto classifier = PixelEdgeClassifier::TrainOnSamples(all, edge_params);
+    if (!classifier.ok()) return classifier.status().WithContext("training the " + name);
+    return classifier;
+  };
+  auto classifier = fit(which, "pixel edge classifier");
+  if (!classifier.ok()) return classifier.status();
+  const auto odds = [&](const PixelEdgeClassifier& c) {
+    return options.prior_correction ? c.sampled_odds_scale() : 1.0;
+  };
+  bundle.params.prior_correction.edge_odds = odds(*classifier);
+  parts["edges"] = {
+      {"kind", "pixel_forest"}, {"learned", true},
+      {"trained", true},        {"frames", which.size()},
+      {"samples", samples},     {"prior_odds", bundle.params.prior_correction.edge_odds}};
   bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*classifier));
+  for (int fold = 0; folds.enabled && fold < kFolds; ++fold) {
+    auto copy =
+        fit(folds.InFold(which, fold), "pixel edge classifier of fold " + std::to_string(fold));
+    if (!copy.ok()) return copy.status().WithContext(kFewFramesHint);
+    folds.upstream[fold].edge_kind = bundle.edge_kind;
+    folds.upstream[fold].params.prior_correction.edge_odds = odds(*copy);
+    folds.upstream[fold].edges = std::make_shared<PixelEdgeClassifier>(std::move(*copy));
+  }
   return Status::Ok();
 }
 
 // §3.4 steps 2-5: the occlusion classifier on superpixel boundaries, pairs frame by frame.
 Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
-                                nlohmann::json& parts) {
+                                ClassifierFolds& folds, nlohmann::json& parts) {
   const TrainOptions& options = run.options();
   const std::vector<int> which = ClassifierFrames(run, survey);
   OcclusionParams params = options.occlusion_params;
@@ -277,8 +347,9 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
   run.Say("occlusion classifier: pairs from " + std::to_string(which.size()) + " frames");
   std::vector<OcclusionSamples> per_frame(run.num_frames());
   const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
-    const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *bundle.edges,
-                                                       nullptr, bundle.params, /*enhance=*/true);
+    const ModelBundle& upstream = folds.For(bundle, i);
+    const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *upstream.edges,
+                                                       nullptr, upstream.params, /*enhance=*/true);
     const OcclusionTrainingFrame frame{oaocc.crop, oaocc.enhanced, oaocc.superpixels,
                                        LabelMap(s)(oaocc.r1.rect()).clone()};
     auto samples = ExtractOcclusionSamples(frame, params, static_cast<std::size_t>(i));
@@ -287,20 +358,36 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
     return Status::Ok();
   }));
   if (!st.ok()) return st.WithContext("occlusion classifier");
-  OcclusionSamples all;
-  for (const OcclusionSamples& f : per_frame) AppendOcclusionSamples(all, f);
-  per_frame.clear();
-  const std::size_t positives = all.positive_targets.size();
-  run.Say("training the occlusion classifier on " + std::to_string(positives) + " contour pairs");
-  auto classifier = OcclusionClassifier::FitOnSamples(std::move(all), params);
-  if (!classifier.ok()) return classifier.status().WithContext("training the occlusion classifier");
+  std::size_t positives = 0;
+  const auto fit = [&](const std::vector<int>& frames,
+                       const std::string& name) -> Result<OcclusionClassifier> {
+    OcclusionSamples all;
+    for (int i : frames) AppendOcclusionSamples(all, per_frame[i]);
+    positives = all.positive_targets.size();
+    run.Say("training the " + name + " on " + std::to_string(positives) + " contour pairs");
+    auto classifier = OcclusionClassifier::FitOnSamples(std::move(all), params);
+    if (!classifier.ok()) return classifier.status().WithContext("training the " + name);
+    return classifier;
+  };
+  const auto odds = [&](const OcclusionClassifier& c) {
+    return options.prior_correction ? c.sampled_odds_scale() : 1.0;
+  };
+  for (int fold = 0; folds.enabled && fold < kFolds; ++fold) {
+    auto copy =
+        fit(folds.InFold(which, fold), "occlusion classifier of fold " + std::to_string(fold));
+    if (!copy.ok()) return copy.status().WithContext(kFewFramesHint);
+    folds.upstream[fold].params.prior_correction.occlusion_odds = odds(*copy);
+    folds.upstream[fold].occlusion = std::move(*copy);
+  }
+  auto classifier = fit(which, "occlusion classifier");
+  if (!classifier.ok()) return classifier.status();
   bundle.occlusion = std::move(*classifier);
-  bundle.params.prior_correction.occlusion_odds =
-      options.prior_correction ? bundle.occlusion.sampled_odds_scale() : 1.0;
+  bundle.params.prior_correction.occlusion_odds = odds(bundle.occlusion);
   parts["occlusion"] = {{"learned", true},
                         {"trained", true},
                         {"frames", which.size()},
                         {"contour_pairs", positives},
+                        {"edge_maps", folds.enabled ? "out_of_fold" : "in_sample"},
                         {"prior_odds", bundle.params.prior_correction.occlusion_odds}};
   return Status::Ok();
 }
@@ -327,6 +414,7 @@ struct RegressorSamples {
 // objectness (TrainOptions::mine_hard_negatives).
 Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey& survey,
                                                  const ModelBundle& bundle,
+                                                 const ClassifierFolds& folds,
                                                  const ModelBundle* miner = nullptr) {
   const TrainOptions& options = run.options();
   const int n = run.num_frames();
@@ -339,8 +427,9 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
   const Status st =
       run.FirstError(survey.usable, run.ForEachFrame(survey.usable, [&](int i, const Sample& s) {
         if (cv::countNonZero(s.road) > 0) {
+          const ModelBundle& upstream = folds.For(bundle, i);
           const OcclusionEdges oaocc = ComputeOcclusionEdges(
-              s.image, bundle.regions, *bundle.edges, &bundle.occlusion, bundle.params, true);
+              s.image, bundle.regions, *upstream.edges, &upstream.occlusion, upstream.params, true);
           const ProposalSet all =
               ProposeBoxes(oaocc, bundle.regions, bundle.params.boxes,
                            DetectorProposalOptions(bundle.params, bundle.regions.num_layers()),
@@ -433,10 +522,10 @@ struct TrainedRegressors {
 // (bootstrapping): the first round's regressors score every training proposal, the negatives
 // are drawn again with their hard share by that score, and the regressors train again.
 Result<TrainedRegressors> TrainRegressors(TrainingRun& run, const Survey& survey,
-                                          const ModelBundle& bundle) {
+                                          const ModelBundle& bundle, const ClassifierFolds& folds) {
   const TrainOptions& options = run.options();
   run.StartStep();
-  auto samples = CollectRegressorSamples(run, survey, bundle);
+  auto samples = CollectRegressorSamples(run, survey, bundle, folds);
   if (!samples.ok()) return samples.status();
   run.EndStep("proposals_and_samples");
 
@@ -454,7 +543,7 @@ Result<TrainedRegressors> TrainRegressors(TrainingRun& run, const Survey& survey
   ModelBundle miner = bundle;
   miner.ordr = std::move(regressors->ordr);
   miner.obdr = std::move(regressors->obdr);
-  auto mined = CollectRegressorSamples(run, survey, bundle, &miner);
+  auto mined = CollectRegressorSamples(run, survey, bundle, folds, &miner);
   if (!mined.ok()) return mined.status().WithContext("mining hard negatives");
   run.Say("training ORDR and OBDR on the mined samples");
   auto second = TrainRegressorPair(
@@ -469,10 +558,9 @@ Result<TrainedRegressors> TrainRegressors(TrainingRun& run, const Survey& survey
 // scored by regressors trained on the other fold of frames (2-fold cross-fitting), then Platt
 // scaling of "covers an obstacle pixel" on the evidence of every component found.
 Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
-                               const RegressorSamples& samples, ModelBundle& bundle,
-                               nlohmann::json& parts) {
-  constexpr int kFolds = 2;
-  const auto fold_of = [](int position) { return position % kFolds; };
+                               const RegressorSamples& samples, const ClassifierFolds& folds,
+                               ModelBundle& bundle, nlohmann::json& parts) {
+  const auto fold_of = [&folds](int frame) { return folds.FoldOf(frame); };
   std::vector<std::vector<std::pair<double, int>>> per_frame(run.num_frames());
   for (int fold = 0; fold < kFolds; ++fold) {
     std::vector<int> which;
@@ -482,7 +570,9 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
     auto pair = TrainRegressorPair(
         samples, [&](int i) { return fold_of(i) != fold; }, RegressorForest(run.options()));
     if (!pair.ok()) return pair.status().WithContext("calibration fold " + std::to_string(fold));
-    ModelBundle fold_bundle = bundle;
+    // Frames of this fold are scored by parts trained on the other fold only: the regressors and,
+    // with out-of-fold maps, the classifiers too.
+    ModelBundle fold_bundle = folds.For(bundle, which.front());
     fold_bundle.ordr = std::move(pair->ordr);
     fold_bundle.obdr = std::move(pair->obdr);
     const ObstacleDetector detector(std::move(fold_bundle), "calibration");
@@ -558,15 +648,19 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   if (Status st = DeriveGeometry(run, *survey, bundle, parts); !st.ok()) return st;
   run.EndStep("survey");
 
+  ClassifierFolds folds(options.out_of_fold_maps, run.num_frames(), survey->usable,
+                        ClassifierFrames(run, *survey));
+  if (folds.enabled) folds.upstream.fill(bundle);  // parameters, geometry; classifiers below
+
   run.StartStep();
-  if (Status st = TrainEdgeSource(run, *survey, bundle, parts); !st.ok()) return st;
+  if (Status st = TrainEdgeSource(run, *survey, bundle, folds, parts); !st.ok()) return st;
   run.EndStep("edges");
 
   run.StartStep();
-  if (Status st = TrainOcclusionClassifier(run, *survey, bundle, parts); !st.ok()) return st;
+  if (Status st = TrainOcclusionClassifier(run, *survey, bundle, folds, parts); !st.ok()) return st;
   run.EndStep("occlusion");
 
-  auto trained = TrainRegressors(run, *survey, bundle);
+  auto trained = TrainRegressors(run, *survey, bundle, folds);
   if (!trained.ok()) return trained.status();
   bundle.ordr = std::move(trained->regressors.ordr);
   bundle.obdr = std::move(trained->regressors.obdr);
@@ -581,11 +675,12 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
                    {"trees", forest.num_trees},
                    {"mtry", forest.max_features},
                    {"min_leaf", forest.min_leaf_size},
-                   {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"}};
+                   {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"},
+                   {"maps", folds.enabled ? "out_of_fold" : "in_sample"}};
 
   run.StartStep();
   run.Say("calibrating obstacle scores (2-fold)");
-  if (Status st = CalibrateObstacleScores(run, *survey, samples, bundle, parts); !st.ok())
+  if (Status st = CalibrateObstacleScores(run, *survey, samples, folds, bundle, parts); !st.ok())
     return st;
   run.EndStep("calibration");
 

@@ -51,6 +51,12 @@ struct TrainOptions {
   // (selection.hard_fraction) from the proposals the first round's regressors score above
   // selection.hard_objectness (fused score) instead of by objectness, and train again.
   bool mine_hard_negatives = false;
+  // Stacked training (not in the paper; README "Real frames"): the maps a learned part trains on
+  // (edge maps for the occlusion classifier; edge and occlusion maps for the regressors and the
+  // score calibration) come from classifiers trained on the other of two folds of frames, so
+  // they are as clean as a new frame's, not as a memorised one's. false: the final classifiers'
+  // maps of frames they have seen (the paper's training).
+  bool out_of_fold_maps = true;
   std::function<void(const std::string&)> progress;  // one line per step
 };
 

@@ -165,6 +165,35 @@ TEST_F(MasksCliTest, SizeFilterRecipeIsAChoiceAndRecorded) {
   EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
 }
 
+// By default each classifier also gets a copy per fold, and every frame's maps for the next part
+// come from the other fold's copy; --in-sample-maps trains on the final classifiers' maps. The
+// manifest says which, and the parts differ (same seed).
+TEST_F(MasksCliTest, OutOfFoldMapsByDefaultInSampleOnRequest) {
+  const std::string stacked = (out_ / "stacked").string(), plain = (out_ / "plain").string();
+  const CommandResult stacked_run = RunCommand(Train(stacked));
+  ASSERT_EQ(stacked_run.exit_code, 0) << stacked_run.output;
+  EXPECT_NE(stacked_run.output.find("occlusion classifier of fold 1"), std::string::npos)
+      << stacked_run.output;
+  const CommandResult plain_run = RunCommand(Train(plain, "--in-sample-maps"));
+  ASSERT_EQ(plain_run.exit_code, 0) << plain_run.output;
+  EXPECT_EQ(plain_run.output.find("of fold"), std::string::npos) << plain_run.output;
+  auto manifest = [](const std::string& model) {
+    std::ifstream in(fs::path(model) / "manifest.json");
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json p = manifest(plain), m = manifest(stacked);
+  EXPECT_EQ(p["training"]["parts"]["occlusion"]["edge_maps"], "in_sample");
+  EXPECT_EQ(m["training"]["parts"]["occlusion"]["edge_maps"], "out_of_fold");
+  for (const char* part : {"ordr", "obdr"}) {
+    EXPECT_EQ(p["training"]["parts"][part]["maps"], "in_sample") << part;
+    EXPECT_EQ(m["training"]["parts"][part]["maps"], "out_of_fold") << part;
+  }
+  // The shipped edge classifier is the same; what it feeds is trained differently.
+  EXPECT_EQ(m["files"]["edges.bin"]["fnv1a64"], p["files"]["edges.bin"]["fnv1a64"]);
+  for (const char* file : {"occlusion.bin", "ordr.bin"})
+    EXPECT_NE(m["files"][file]["fnv1a64"], p["files"][file]["fnv1a64"]) << file;
+}
+
 TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
   // A copy of the dataset with one corrupt test image.
   const fs::path copy = out_ / "data";
@@ -188,7 +217,8 @@ TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
 
   const CommandResult skipped =
       RunCommand(tod_ + " train --data " + copy.string() + " --split all --out " + model +
-                 " --trees 5 --classifier-frames 4 --no-eval --on-bad-frame skip --threads 2");
+                 " --trees 5 --classifier-frames 4 --no-eval --on-bad-frame skip --threads 2"
+                 " --in-sample-maps");  // 2 classifier frames a fold are too few for fold copies
   ASSERT_EQ(skipped.exit_code, 0) << skipped.output;
   EXPECT_NE(skipped.output.find("skipped frame " + stem), std::string::npos) << skipped.output;
   std::ifstream in(fs::path(model) / "manifest.json");
