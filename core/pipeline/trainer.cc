@@ -257,6 +257,19 @@ struct ClassifierFolds {
   }
 };
 
+// Trains the fold copies of a classifier (nothing when folds are off): fit(frames of fold f,
+// name) for each fold f, then install(upstream bundle of fold f, the copy).
+template <typename Fit, typename Install>
+Status TrainFoldCopies(ClassifierFolds& folds, const std::vector<int>& which,
+                       const std::string& name, const Fit& fit, const Install& install) {
+  for (int fold = 0; folds.enabled && fold < kFolds; ++fold) {
+    auto copy = fit(folds.InFold(which, fold), name + " of fold " + std::to_string(fold));
+    if (!copy.ok()) return copy.status().WithContext(kFewFramesHint);
+    install(folds.upstream[fold], std::move(*copy));
+  }
+  return Status::Ok();
+}
+
 // An edge source that is not learned has seen no frame: every fold uses it as it is.
 void ShareUnlearnedEdges(const ModelBundle& bundle, ClassifierFolds& folds) {
   for (ModelBundle& upstream : folds.upstream) {
@@ -325,15 +338,12 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
       {"trained", true},        {"frames", which.size()},
       {"samples", samples},     {"prior_odds", bundle.params.prior_correction.edge_odds}};
   bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*classifier));
-  for (int fold = 0; folds.enabled && fold < kFolds; ++fold) {
-    auto copy =
-        fit(folds.InFold(which, fold), "pixel edge classifier of fold " + std::to_string(fold));
-    if (!copy.ok()) return copy.status().WithContext(kFewFramesHint);
-    folds.upstream[fold].edge_kind = bundle.edge_kind;
-    folds.upstream[fold].params.prior_correction.edge_odds = odds(*copy);
-    folds.upstream[fold].edges = std::make_shared<PixelEdgeClassifier>(std::move(*copy));
-  }
-  return Status::Ok();
+  return TrainFoldCopies(folds, which, "pixel edge classifier", fit,
+                         [&](ModelBundle& upstream, PixelEdgeClassifier copy) {
+                           upstream.edge_kind = bundle.edge_kind;
+                           upstream.params.prior_correction.edge_odds = odds(copy);
+                           upstream.edges = std::make_shared<PixelEdgeClassifier>(std::move(copy));
+                         });
 }
 
 // §3.4 steps 2-5: the occlusion classifier on superpixel boundaries, pairs frame by frame.
@@ -372,13 +382,13 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
   const auto odds = [&](const OcclusionClassifier& c) {
     return options.prior_correction ? c.sampled_odds_scale() : 1.0;
   };
-  for (int fold = 0; folds.enabled && fold < kFolds; ++fold) {
-    auto copy =
-        fit(folds.InFold(which, fold), "occlusion classifier of fold " + std::to_string(fold));
-    if (!copy.ok()) return copy.status().WithContext(kFewFramesHint);
-    folds.upstream[fold].params.prior_correction.occlusion_odds = odds(*copy);
-    folds.upstream[fold].occlusion = std::move(*copy);
-  }
+  if (Status st = TrainFoldCopies(folds, which, "occlusion classifier", fit,
+                                  [&](ModelBundle& upstream, OcclusionClassifier copy) {
+                                    upstream.params.prior_correction.occlusion_odds = odds(copy);
+                                    upstream.occlusion = std::move(copy);
+                                  });
+      !st.ok())
+    return st;
   auto classifier = fit(which, "occlusion classifier");
   if (!classifier.ok()) return classifier.status();
   bundle.occlusion = std::move(*classifier);

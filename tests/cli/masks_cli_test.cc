@@ -72,6 +72,11 @@ class MasksCliTest : public ::testing::Test {
            " --trees 10 --classifier-frames 6 --no-eval --threads 2 " + extra;
   }
 
+  static nlohmann::json Manifest(const std::string& model) {
+    std::ifstream in(fs::path(model) / "manifest.json");
+    return nlohmann::json::parse(in);
+  }
+
   static fs::path* root_;
   std::string tod_;
   fs::path out_;
@@ -132,11 +137,7 @@ TEST_F(MasksCliTest, HardNegativeMiningIsOptInAndRecorded) {
   const CommandResult mined_run = RunCommand(Train(mined, "--mine-hard-negatives"));
   ASSERT_EQ(mined_run.exit_code, 0) << mined_run.output;
   EXPECT_NE(mined_run.output.find("mining hard negatives"), std::string::npos) << mined_run.output;
-  auto manifest = [](const std::string& model) {
-    std::ifstream in(fs::path(model) / "manifest.json");
-    return nlohmann::json::parse(in);
-  };
-  const nlohmann::json p = manifest(plain), m = manifest(mined);
+  const nlohmann::json p = Manifest(plain), m = Manifest(mined);
   for (const char* part : {"ordr", "obdr"}) {
     EXPECT_EQ(m["training"]["parts"][part]["hard_negatives"], "mined") << part;
     EXPECT_EQ(m["training"]["parts"][part]["trained"], true) << part;
@@ -177,11 +178,7 @@ TEST_F(MasksCliTest, OutOfFoldMapsByDefaultInSampleOnRequest) {
   const CommandResult plain_run = RunCommand(Train(plain, "--in-sample-maps"));
   ASSERT_EQ(plain_run.exit_code, 0) << plain_run.output;
   EXPECT_EQ(plain_run.output.find("of fold"), std::string::npos) << plain_run.output;
-  auto manifest = [](const std::string& model) {
-    std::ifstream in(fs::path(model) / "manifest.json");
-    return nlohmann::json::parse(in);
-  };
-  const nlohmann::json p = manifest(plain), m = manifest(stacked);
+  const nlohmann::json p = Manifest(plain), m = Manifest(stacked);
   EXPECT_EQ(p["training"]["parts"]["occlusion"]["edge_maps"], "in_sample");
   EXPECT_EQ(m["training"]["parts"]["occlusion"]["edge_maps"], "out_of_fold");
   for (const char* part : {"ordr", "obdr"}) {
