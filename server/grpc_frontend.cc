@@ -164,6 +164,14 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
   // Owned here (not by gRPC) so the image bytes live until the engine's completion has run.
   auto request = std::make_shared<tod::v1::DetectRequest>();
   if (Status parsed = ParseMessage(request_bytes, request.get()); !parsed.ok()) {
+    if (context->IsCancelled()) {  // the request never arrived whole: not a malformed one
+      const grpc::Status status(grpc::StatusCode::CANCELLED,
+                                "the client cancelled the call before its request arrived");
+      log(default_frame_id.empty() ? request_id : default_frame_id, request_bytes.Length(),
+          status, 0, CancelReasonName(CancelReason::kClientCancelled));
+      done(status);
+      return;
+    }
     metrics_.RecordRejection("bad_request");
     const grpc::Status status = ToGrpcStatus(parsed);
     log(default_frame_id.empty() ? request_id : default_frame_id, request_bytes.Length(), status,

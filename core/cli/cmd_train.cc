@@ -68,10 +68,11 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_flag("--refine-all", args->refine_all,
                 "refine every scoring window, as the paper (default: the 5000 best grid local "
                 "maxima per region)");
-  cmd->add_flag("--mine-hard-negatives", args->train.mine_hard_negatives,
+  cmd->add_flag("--mine-hard-negatives,!--no-mine-hard-negatives",
+                args->train.mine_hard_negatives,
                 "train the regressors twice, the second time with the first round's best-scored "
-                "non-obstacles as hard negatives (default: one round, hard negatives by "
-                "objectness, as the paper)");
+                "non-obstacles as hard negatives (the default; --no-mine-hard-negatives: one "
+                "round, hard negatives by objectness, as the paper)");
   bool* out_of_fold = &args->train.out_of_fold_maps;
   cmd->add_flag_callback(
       "--in-sample-maps", [out_of_fold] { *out_of_fold = false; },

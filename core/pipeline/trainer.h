@@ -46,11 +46,12 @@ struct TrainOptions {
   OcclusionParams occlusion_params;
   ForestParams regressor{.num_trees = 200, .max_features = 6, .min_leaf_size = 5};
   SampleSelectionParams selection;
-  // Bootstrapping (not in the paper; off by default, README "Real frames"): after a first
-  // training round, sample the regressors' negatives again, taking the "hard" share
-  // (selection.hard_fraction) from the proposals the first round's regressors score above
-  // selection.hard_objectness (fused score) instead of by objectness, and train again.
-  bool mine_hard_negatives = false;
+  // Bootstrapping (not in the paper; README "Real frames"): after a first training round,
+  // sample the regressors' negatives again, taking the "hard" share (selection.hard_fraction)
+  // from the proposals the first round's regressors score above selection.hard_objectness
+  // (fused score) instead of by objectness, and train again. false: one round, hard negatives
+  // by objectness (the paper's training).
+  bool mine_hard_negatives = true;
   // Stacked training (not in the paper; README "Real frames"): the maps a learned part trains on
   // (edge maps for the occlusion classifier; edge and occlusion maps for the regressors and the
   // score calibration) come from classifiers trained on the other of two folds of frames, so

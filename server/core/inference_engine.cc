@@ -211,8 +211,10 @@ void InferenceEngine::WorkerLoop() {
     } else {
       result = Run(job);
     }
-    Finish(job.done, std::move(result), job.submitted);
+    // Out of the gauge before the answer goes out: a client that has its answer must never see
+    // its request still in flight.
     if (metrics_ != nullptr) metrics_->AddInFlight(-1);
+    Finish(job.done, std::move(result), job.submitted);
     {
       std::lock_guard lock(mutex_);
       --running_;
@@ -344,9 +346,9 @@ void InferenceEngine::CancelAll(CancelReason reason) {
   }
   for (Job& job : queued) {
     job.cancellation->Cancel(reason);
+    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
     Finish(job.done, Stopped(*job.cancellation->reason(), "while the request was queued"),
            job.submitted);
-    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
   }
   idle_.notify_all();
 }
@@ -367,11 +369,11 @@ void InferenceEngine::Stop() {
     leftover.swap(queue_);
   }
   for (Job& job : leftover) {
+    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
     Finish(job.done,
            Refusal(Status::Unavailable("server shut down before the request ran"),
                    Rejection::kNotReady),
            job.submitted);
-    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
   }
 }
 

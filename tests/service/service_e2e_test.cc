@@ -266,7 +266,7 @@ TEST_F(ServiceE2ETest, AFrameOverItsBudgetDegradesSaysSoAndIsCounted) {
   EXPECT_EQ(grpc_->Detect(request, &response).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 }
 
-TEST_F(ServiceE2ETest, TheCalibratedMapPeaksAtTheCalibratedScoreOfTheBestBox) {
+TEST_F(ServiceE2ETest, TheCalibratedMapIsBoundedByTheBestBoxsCalibratedScore) {
   const std::string frame = testing::RoadPng();
   tod::v1::ModelInfo info;
   ASSERT_TRUE(grpc_->GetModelInfo(&info).ok());
@@ -291,7 +291,13 @@ TEST_F(ServiceE2ETest, TheCalibratedMapPeaksAtTheCalibratedScoreOfTheBestBox) {
   ASSERT_GT(best, 0.0);
   const double expected = 255.0 / (1.0 + std::exp(-(calibration["slope"].get<double>() * best +
                                                     calibration["intercept"].get<double>())));
-  EXPECT_NEAR(peak_of(response.probability_map().png()), expected, 1.0);
+  // A pixel holds a box's calibrated score times the share of its superpixel the box holds, so
+  // no pixel exceeds the best box's calibrated score (8-bit rounding aside), and the pixels of
+  // the best box are not zero. It is a probability, not divided by the frame's maximum (255).
+  const double peak = peak_of(response.probability_map().png());
+  EXPECT_LE(peak, expected + 1.0);
+  EXPECT_GT(peak, 0.0);
+  EXPECT_LT(expected, 254.0);
 
   const auto rest = PostImage(*http_, "/v1/detect?map_kind=calibrated", frame);
   ASSERT_TRUE(rest);
