@@ -167,8 +167,8 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
     if (context->IsCancelled()) {  // the request never arrived whole: not a malformed one
       const grpc::Status status(grpc::StatusCode::CANCELLED,
                                 "the client cancelled the call before its request arrived");
-      log(default_frame_id.empty() ? request_id : default_frame_id, request_bytes.Length(),
-          status, 0, CancelReasonName(CancelReason::kClientCancelled));
+      log(default_frame_id.empty() ? request_id : default_frame_id, request_bytes.Length(), status,
+          0, CancelReasonName(CancelReason::kClientCancelled));
       done(status);
       return;
     }
