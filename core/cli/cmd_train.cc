@@ -49,6 +49,12 @@ Runner AddTrainCommand(CLI::App& app) {
                   "frames for the edge and occlusion classifiers");
   cmd->add_option("--trees", args->trees, "trees per regressor (paper: 200)")
       ->check(CLI::Range(1, 2000));
+  cmd->add_option("--edge-trees", args->train.edge_params.forest.num_trees,
+                  "trees of the pixel edge classifier")
+      ->check(CLI::Range(1, 200));
+  cmd->add_option("--occlusion-trees", args->train.occlusion_params.forest.num_trees,
+                  "trees of the occlusion classifier")
+      ->check(CLI::Range(1, 2000));
   cmd->add_option("--threads", args->train.threads, "worker threads (0 = all cores)");
   cmd->add_option("--on-bad-frame", args->on_bad_frame,
                   "fail: stop at an unreadable frame; skip: leave it out, list and count it")
@@ -68,8 +74,7 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_flag("--refine-all", args->refine_all,
                 "refine every scoring window, as the paper (default: the 5000 best grid local "
                 "maxima per region)");
-  cmd->add_flag("--mine-hard-negatives,!--no-mine-hard-negatives",
-                args->train.mine_hard_negatives,
+  cmd->add_flag("--mine-hard-negatives,!--no-mine-hard-negatives", args->train.mine_hard_negatives,
                 "train the regressors twice, the second time with the first round's best-scored "
                 "non-obstacles as hard negatives (the default; --no-mine-hard-negatives: one "
                 "round, hard negatives by objectness, as the paper)");

@@ -53,7 +53,9 @@ class GradientEdgeSource : public EdgeSource {
  public:
   explicit GradientEdgeSource(const GradientEdgeParams& params) : params_(params) {}
 
-  cv::Mat1f Compute(const cv::Mat3b& bgr) const override {
+  using EdgeSource::Compute;
+  cv::Mat1f Compute(const cv::Mat3b& bgr,
+                    const EdgeScreening& /*not a tree ensemble*/) const override {
     if (bgr.empty()) return {};
     const cv::Mat3f luv = TriangleSmooth(BgrToLuv(bgr), params_.smooth_radius);
     cv::Mat1f edge = ComputeColourGradient(luv, /*with_orientation=*/false).magnitude;

@@ -136,7 +136,7 @@ Result<PixelEdgeClassifier> PixelEdgeClassifier::TryTrain(
   return TrainOnSamples(all, params);
 }
 
-cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr) const {
+cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr, const EdgeScreening& screening) const {
   if (bgr.empty()) return {};
   if (forest_.empty()) return cv::Mat1f::zeros(bgr.size());
   const EdgeChannels channels = ComputeEdgeChannels(bgr, channel_params_);
@@ -147,7 +147,8 @@ cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr) const {
     for (int i = rows.start; i < rows.end; ++i) {
       extractor.ExtractRow(i, &row_features);
       // One batch per row: the forest walks each tree over the whole row (cache-friendly).
-      const std::vector<float> predicted = forest_.PredictBatch(row_features);
+      const std::vector<float> predicted =
+          forest_.PredictBatchScreened(row_features, screening.trees, screening.final_at_most);
       std::copy(predicted.begin(), predicted.end(), cell_map.ptr<float>(i));
     }
   });

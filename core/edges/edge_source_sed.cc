@@ -16,7 +16,9 @@ class SedEdgeSource : public EdgeSource {
   explicit SedEdgeSource(cv::Ptr<cv::ximgproc::StructuredEdgeDetection> detector)
       : detector_(std::move(detector)) {}
 
-  cv::Mat1f Compute(const cv::Mat3b& bgr) const override {
+  using EdgeSource::Compute;
+  cv::Mat1f Compute(const cv::Mat3b& bgr,
+                    const EdgeScreening& /*not a tree ensemble*/) const override {
     if (bgr.empty()) return {};
     cv::Mat3f rgb;
     bgr.convertTo(rgb, CV_32F, 1.0 / 255.0);  // the detector wants float RGB in [0,1]

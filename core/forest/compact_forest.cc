@@ -51,31 +51,35 @@ CompactForest CompactForest::Build(const std::vector<ForestNode>& nodes,
   return packed;
 }
 
-void CompactForest::AccumulateLeafValues(const float* const* rows, int count, double* sums) const {
+void CompactForest::AccumulateLeafValues(const float* const* rows, int count, double* sums,
+                                         int tree_begin, int tree_end) const {
   // The proposal regressors have 20 features (5 bits), the pixel edge forest 49 (6 bits).
   switch (feature_bits_) {
     case 1:
-      return AccumulateCopied<1>(rows, count, sums);
+      return AccumulateCopied<1>(rows, count, sums, tree_begin, tree_end);
     case 2:
-      return AccumulateCopied<2>(rows, count, sums);
+      return AccumulateCopied<2>(rows, count, sums, tree_begin, tree_end);
     case 3:
-      return AccumulateCopied<3>(rows, count, sums);
+      return AccumulateCopied<3>(rows, count, sums, tree_begin, tree_end);
     case 4:
-      return AccumulateCopied<4>(rows, count, sums);
+      return AccumulateCopied<4>(rows, count, sums, tree_begin, tree_end);
     case 5:
-      return AccumulateCopied<5>(rows, count, sums);
+      return AccumulateCopied<5>(rows, count, sums, tree_begin, tree_end);
     case 6:
-      return AccumulateCopied<6>(rows, count, sums);
+      return AccumulateCopied<6>(rows, count, sums, tree_begin, tree_end);
     case 7:
-      return AccumulateCopied<7>(rows, count, sums);
+      return AccumulateCopied<7>(rows, count, sums, tree_begin, tree_end);
     default:  // wider rows: the same walk with the width read at run time
-      return AccumulateCopied<0>(rows, count, sums);
+      return AccumulateCopied<0>(rows, count, sums, tree_begin, tree_end);
   }
 }
 
 template <int kFeatureBits>
-void CompactForest::AccumulateCopied(const float* const* rows, int count, double* sums) const {
-  if (count <= 0) return;
+void CompactForest::AccumulateCopied(const float* const* rows, int count, double* sums,
+                                     int tree_begin, int tree_end) const {
+  tree_begin = std::max(tree_begin, 0);
+  tree_end = std::min(tree_end, static_cast<int>(roots_.size()));
+  if (count <= 0 || tree_begin >= tree_end) return;
   const int bits = kFeatureBits > 0 ? kFeatureBits : feature_bits_;
   const std::size_t stride = std::size_t{1} << bits;
   const std::uint32_t mask = (std::uint32_t{1} << bits) - 1;
@@ -88,7 +92,8 @@ void CompactForest::AccumulateCopied(const float* const* rows, int count, double
   for (int r = 0; r < count; ++r) std::copy_n(rows[r], num_features_, &copied[r * stride]);
   std::fill(copied.get() + count * stride, copied.get() + padded_rows * stride, 0.f);
   const PackedNode* const nodes = nodes_.data();
-  for (const std::uint32_t root : roots_) {
+  for (int tree = tree_begin; tree < tree_end; ++tree) {
+    const std::uint32_t root = roots_[tree];
     for (int first = 0; first < count; first += kLanes) {
       const float* const group = &copied[first * stride];
       std::array<std::uint32_t, kLanes> at;

@@ -41,9 +41,11 @@ class CompactForest {
   // Bytes a prediction may touch per node: the packed node and its leaf value.
   static constexpr std::size_t bytes_per_node() { return sizeof(PackedNode) + sizeof(float); }
 
-  // For every tree in order, adds the value of the leaf that rows[k] reaches to sums[k], for
-  // k in [0, count). Each row must hold at least num_features values.
-  void AccumulateLeafValues(const float* const* rows, int count, double* sums) const;
+  // For every tree of [tree_begin, tree_end) in order, adds the value of the leaf that rows[k]
+  // reaches to sums[k], for k in [0, count). Each row must hold at least num_features values.
+  // Going on from tree_end later adds the same values in the same order as one call would.
+  void AccumulateLeafValues(const float* const* rows, int count, double* sums, int tree_begin,
+                            int tree_end) const;
 
  private:
   struct PackedNode {
@@ -55,7 +57,8 @@ class CompactForest {
   // The walk over rows copied to a stride of 2^kFeatureBits floats (see above); kFeatureBits 0
   // reads the width from feature_bits_ (rows of more than 128 features).
   template <int kFeatureBits>
-  void AccumulateCopied(const float* const* rows, int count, double* sums) const;
+  void AccumulateCopied(const float* const* rows, int count, double* sums, int tree_begin,
+                        int tree_end) const;
 
   int feature_bits_ = 0;
   int num_features_ = 0;

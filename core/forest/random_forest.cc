@@ -184,32 +184,71 @@ int RandomForest::PredictionBlockRows() const {
   return static_cast<int>(std::clamp(rows, static_cast<double>(kMinBlockRows), 1e9));
 }
 
-void RandomForest::PredictRows(const float* const* rows, int count, float* out) const {
+void RandomForest::AccumulateTrees(const float* const* rows, int count, int tree_begin,
+                                   int tree_end, double* sums) const {
   // Blocks of rows walk one tree after another so a tree stays in cache across the block.
-  // Per row the sum runs over trees in the same order as Predict: results are identical.
   const int rows_per_block = PredictionBlockRows();
-  std::vector<double> sums(static_cast<std::size_t>(std::min(count, rows_per_block)));
-  const auto trees = static_cast<double>(tree_roots_.size());
   for (int start = 0; start < count; start += rows_per_block) {
     const int block = std::min(count - start, rows_per_block);
     const float* const* block_rows = rows + start;
-    std::fill(sums.begin(), sums.end(), 0.0);
+    double* const block_sums = sums + start;
     if (!compact_.empty()) {
-      compact_.AccumulateLeafValues(block_rows, block, sums.data());
-    } else {  // too many nodes to pack: walk the stored nodes (same order, same sums)
-      for (const std::int32_t root : tree_roots_) {
-        for (int r = 0; r < block; ++r) {
-          std::int32_t i = root;
-          while (nodes_[i].feature >= 0) {
-            const Node& node = nodes_[i];
-            i = node.left + (block_rows[r][node.feature] > node.value ? 1 : 0);
-          }
-          sums[r] += nodes_[i].value;
+      compact_.AccumulateLeafValues(block_rows, block, block_sums, tree_begin, tree_end);
+      continue;
+    }
+    // Too many nodes to pack: walk the stored nodes (same order, same sums).
+    for (int tree = tree_begin; tree < tree_end; ++tree) {
+      for (int r = 0; r < block; ++r) {
+        std::int32_t i = tree_roots_[tree];
+        while (nodes_[i].feature >= 0) {
+          const Node& node = nodes_[i];
+          i = node.left + (block_rows[r][node.feature] > node.value ? 1 : 0);
         }
+        block_sums[r] += nodes_[i].value;
       }
     }
-    for (int r = 0; r < block; ++r) out[start + r] = static_cast<float>(sums[r] / trees);
   }
+}
+
+void RandomForest::PredictRows(const float* const* rows, int count, float* out) const {
+  // Per row the sum runs over trees in the same order as Predict: results are identical.
+  std::vector<double> sums(static_cast<std::size_t>(count), 0.0);
+  AccumulateTrees(rows, count, 0, num_trees(), sums.data());
+  const auto trees = static_cast<double>(tree_roots_.size());
+  for (int r = 0; r < count; ++r) out[r] = static_cast<float>(sums[r] / trees);
+}
+
+std::vector<float> RandomForest::PredictBatchScreened(const cv::Mat1f& features, int screen_trees,
+                                                      float final_at_most) const {
+  if (screen_trees <= 0 || screen_trees >= num_trees()) return PredictBatch(features);
+  if (features.rows <= 0) return {};
+  if (features.cols != num_features_) return {};
+  const int count = features.rows;
+  std::vector<const float*> rows(count);
+  for (int r = 0; r < count; ++r) rows[r] = features[r];
+  std::vector<double> sums(static_cast<std::size_t>(count), 0.0);
+  AccumulateTrees(rows.data(), count, 0, screen_trees, sums.data());
+  std::vector<float> out(count);
+  // The rows that go on keep their partial sums, so their totals are PredictBatch's.
+  std::vector<const float*> going_on_rows;
+  std::vector<double> going_on_sums;
+  std::vector<int> going_on;
+  for (int r = 0; r < count; ++r) {
+    const float screened = static_cast<float>(sums[r] / static_cast<double>(screen_trees));
+    if (screened <= final_at_most) {
+      out[r] = screened;
+    } else {
+      going_on.push_back(r);
+      going_on_rows.push_back(rows[r]);
+      going_on_sums.push_back(sums[r]);
+    }
+  }
+  AccumulateTrees(going_on_rows.data(), static_cast<int>(going_on.size()), screen_trees,
+                  num_trees(), going_on_sums.data());
+  const auto trees = static_cast<double>(num_trees());
+  for (std::size_t k = 0; k < going_on.size(); ++k)
+    out[going_on[k]] = static_cast<float>(going_on_sums[k] / trees);
+  return out;
 }
 
 std::vector<float> RandomForest::PredictBatch(const cv::Mat1f& features) const {

@@ -50,6 +50,15 @@ class RandomForest {
   // [0, features.rows).
   std::vector<float> PredictBatch(const cv::Mat1f& features, const std::vector<int>& subset) const;
 
+  // Early exit (a cascade over the trees in their stored order): every row is first walked
+  // through the first `screen_trees` trees; a row whose mean over them is at most
+  // `final_at_most` gets that mean, every other row the whole forest's mean, bit-identical to
+  // PredictBatch. screen_trees <= 0 or >= num_trees(): exactly PredictBatch. The trees of a
+  // forest are drawn alike, so the first ones' mean estimates the whole forest's; a caller picks
+  // `final_at_most` where the difference no longer matters (PixelEdgeClassifier::Compute).
+  std::vector<float> PredictBatchScreened(const cv::Mat1f& features, int screen_trees,
+                                          float final_at_most) const;
+
   int num_features() const { return num_features_; }
   int num_trees() const { return static_cast<int>(tree_roots_.size()); }
   bool empty() const { return tree_roots_.empty(); }
@@ -74,6 +83,10 @@ class RandomForest {
   // Sums the trees' outputs for `count` rows (tree order per row, as Predict) and writes the
   // means to out[0, count).
   void PredictRows(const float* const* rows, int count, float* out) const;
+  // Adds the outputs of trees [tree_begin, tree_end) to sums[0, count), tree order per row, in
+  // blocks of rows (PredictionBlockRows).
+  void AccumulateTrees(const float* const* rows, int count, int tree_begin, int tree_end,
+                       double* sums) const;
   // Rebuilds compact_ from nodes_ and tree_roots_; called whenever those change.
   void PackForPrediction();
 

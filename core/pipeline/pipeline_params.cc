@@ -23,11 +23,12 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FusionParams, beta1, keep_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score, nms_iou, max_boxes,
                                                 top_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PriorCorrection, edge_odds, occlusion_odds)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeScreening, trees, final_at_most)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ObstacleCalibration, fitted, slope, intercept,
                                                 samples, positives)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradient_edges,
                                                 superpixels, boxes, multistride, size_filter,
-                                                region_merge_iou, prior_correction,
+                                                region_merge_iou, prior_correction, edge_screening,
                                                 obstacle_calibration, fusion, probability_map)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
@@ -54,10 +55,13 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
   if (p.regions.num_layers < 1 || p.superpixels.k < 1 || p.fusion.keep_ratio < 0 ||
       p.fusion.keep_ratio > 1 || p.probability_map.top_fraction < 0 ||
       p.probability_map.top_fraction > 1 || !(p.region_merge_iou > 0 && p.region_merge_iou <= 1) ||
-      !(p.prior_correction.edge_odds > 0) || !(p.prior_correction.occlusion_odds > 0))
+      !(p.prior_correction.edge_odds > 0) || !(p.prior_correction.occlusion_odds > 0) ||
+      p.edge_screening.trees < 0 ||
+      !(p.edge_screening.final_at_most >= 0 && p.edge_screening.final_at_most < 1))
     return Status::InvalidArgument(
         "parameters out of range (regions.num_layers, superpixels.k, fusion.keep_ratio, "
-        "probability_map.top_fraction, region_merge_iou in (0, 1], prior_correction > 0)");
+        "probability_map.top_fraction, region_merge_iou in (0, 1], prior_correction > 0, "
+        "edge_screening.trees >= 0, edge_screening.final_at_most in [0, 1))");
   return p;
 }
 

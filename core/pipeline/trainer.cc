@@ -333,10 +333,13 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
     return options.prior_correction ? c.sampled_odds_scale() : 1.0;
   };
   bundle.params.prior_correction.edge_odds = odds(*classifier);
-  parts["edges"] = {
-      {"kind", "pixel_forest"}, {"learned", true},
-      {"trained", true},        {"frames", which.size()},
-      {"samples", samples},     {"prior_odds", bundle.params.prior_correction.edge_odds}};
+  parts["edges"] = {{"kind", "pixel_forest"},
+                    {"learned", true},
+                    {"trained", true},
+                    {"frames", which.size()},
+                    {"samples", samples},
+                    {"prior_odds", bundle.params.prior_correction.edge_odds},
+                    {"trees", edge_params.forest.num_trees}};
   bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*classifier));
   return TrainFoldCopies(folds, which, "pixel edge classifier", fit,
                          [&](ModelBundle& upstream, PixelEdgeClassifier copy) {
@@ -398,7 +401,8 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
                         {"frames", which.size()},
                         {"contour_pairs", positives},
                         {"edge_maps", folds.enabled ? "out_of_fold" : "in_sample"},
-                        {"prior_odds", bundle.params.prior_correction.occlusion_odds}};
+                        {"prior_odds", bundle.params.prior_correction.occlusion_odds},
+                        {"trees", params.forest.num_trees}};
   return Status::Ok();
 }
 

@@ -94,6 +94,9 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
   for (const char* part : {"edges", "occlusion", "ordr", "obdr", "calibration"})
     EXPECT_EQ(manifest["training"]["parts"][part]["trained"], true) << part;
   EXPECT_EQ(manifest["training"]["parts"]["ordr"]["hard_negatives"], "mined");
+  EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 16);
+  EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 100);
+  EXPECT_EQ(manifest["params"]["edge_screening"]["trees"], 0);  // off: every tree on every cell
   const nlohmann::json& size_filter = manifest["training"]["parts"]["size_filter"];
   EXPECT_EQ(size_filter["recipe"], "ground_plane") << size_filter.dump();
   EXPECT_TRUE(size_filter["horizon_y"].is_number()) << size_filter.dump();
@@ -150,6 +153,21 @@ TEST_F(MasksCliTest, HardNegativeMiningByDefaultOneRoundOnRequest) {
         << part;
   }
   EXPECT_TRUE(m["training"]["seconds"].contains("hard_negatives"));
+}
+
+// The classifiers' tree counts are choices the manifest records; out of range is refused before
+// any work.
+TEST_F(MasksCliTest, ClassifierTreeCountsAreChoicesAndRecorded) {
+  const std::string model = (out_ / "trees").string();
+  const CommandResult run = RunCommand(Train(model, "--edge-trees 4 --occlusion-trees 12"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json manifest = Manifest(model);
+  EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 4);
+  EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 12);
+  const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), "--edge-trees 0"));
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_NE(wrong.output.find("--edge-trees"), std::string::npos) << wrong.output;
+  EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
 }
 
 // --size-filter-recipe bands restores the authors' per-band extremes (three bands); the manifest

@@ -253,5 +253,55 @@ TEST(BatchPrediction, SubsetRejectsBadInput) {
   EXPECT_TRUE(untrained.PredictBatch(rows, {4}).empty());
 }
 
+// The early exit: with the hand-built forest (a, 10, a), screening on the first tree stops the
+// rows whose a is at most the bound at a; the others get the whole mean, exactly PredictBatch's.
+TEST(ScreenedPrediction, HandBuiltForestStopsOnlyTheRowsAtOrUnderTheBound) {
+  const RandomForest forest = ThreeTreeForest();
+  // Rows reaching a = 1, 2 and 4 in tree A.
+  cv::Mat1f rows(3, 2);
+  rows(0, 0) = 0.2f, rows(0, 1) = 0.f;   // x0 <= 0.5: a = 1
+  rows(1, 0) = 0.9f, rows(1, 1) = 0.1f;  // a = 2
+  rows(2, 0) = 0.9f, rows(2, 1) = 0.9f;  // a = 4
+  const std::vector<float> full = forest.PredictBatch(rows);
+  const std::vector<float> screened = forest.PredictBatchScreened(rows, 1, 2.f);
+  ASSERT_EQ(screened.size(), 3u);
+  EXPECT_EQ(screened[0], 1.f);  // the first tree's value: at or under the bound
+  EXPECT_EQ(screened[1], 2.f);
+  EXPECT_EQ(screened[2], full[2]);  // over it: the whole forest, bit for bit
+  EXPECT_EQ(full[2], Mean3(4.0));
+}
+
+// Screening off (no trees, or every tree) is PredictBatch itself, and on a trained forest every
+// row that goes on is bit-identical to PredictBatch while the stopped ones hold the first
+// trees' mean, at or under the bound: over many blocks of rows.
+TEST(ScreenedPrediction, TrainedForestGoesOnBitForBitAndStopsAtTheFirstTreesMean) {
+  const Data train = MakeData(3000, 6, 5);
+  ForestParams p;
+  p.num_trees = 12;
+  p.min_leaf_size = 3;
+  p.threads = 1;
+  const RandomForest forest = RandomForest::Train(train.x, train.y, p);
+  ASSERT_EQ(forest.num_trees(), 12);
+  const Data test = MakeData(20000, 6, 6);
+  const std::vector<float> full = forest.PredictBatch(test.x);
+  EXPECT_EQ(forest.PredictBatchScreened(test.x, 0, 0.5f), full);
+  EXPECT_EQ(forest.PredictBatchScreened(test.x, 12, 0.5f), full);
+  const float bound = 0.4f;
+  const std::vector<float> screened = forest.PredictBatchScreened(test.x, 4, bound);
+  ASSERT_EQ(screened.size(), full.size());
+  int stopped = 0, went_on = 0;
+  for (int r = 0; r < test.x.rows; ++r) {
+    if (screened[r] == full[r]) {
+      ++went_on;
+      continue;
+    }
+    ++stopped;
+    EXPECT_LE(screened[r], bound) << r;
+  }
+  // Both kinds occur, so both paths are exercised.
+  EXPECT_GT(stopped, 1000);
+  EXPECT_GT(went_on, 1000);
+}
+
 }  // namespace
 }  // namespace tod
