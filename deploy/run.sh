@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The README's first command: install dependencies, build (incremental when run again), show one
 # detection with the shipped default model, then run the service on it in the foreground.
-#   TOD_GRPC_PORT (default 50051), TOD_HTTP_PORT (default 8080), BUILD_DIR (default build)
+#   TOD_GRPC_PORT (default 8001), TOD_HTTP_PORT (default 8000), BUILD_DIR (default build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash deploy/deps.sh build
