@@ -53,9 +53,10 @@ struct PipelineParams {
   PriorCorrection prior_correction;
   // Early exit in the pixel edge classifier (ours, off by default; EdgeScreening): e.g. {8, 0.02}
   // lets a cell whose mean over the first 8 trees is at most 0.02 keep that mean (half the cells
-  // of a real frame). Measured on the dev folds it cost more than it saved: the occlusion
-  // classifier reads the fine structure of the small edge values, which the first trees alone
-  // leave noisier (README, "Real frames"). {0, 0}: every tree on every cell.
+  // of a real frame). Measured on the dev folds with 32 trees, it cost more quality than the
+  // extra trees gave: the occlusion classifier reads the fine structure of the small edge
+  // values, which the first trees alone leave noisier (README, "Real frames", point 9).
+  // {0, 0}: every tree on every cell.
   EdgeScreening edge_screening;
   ObstacleCalibration obstacle_calibration;  // fitted by `tod train`
   FusionParams fusion;
