@@ -49,7 +49,8 @@ void PublishModel(const ModelHolder& models, ServerMetrics& metrics) {
            {{"dir", model->model_dir},
             {"name", info.name},
             {"version", info.version},
-            {"generation", model->generation}});
+            {"generation", model->generation},
+            {"warm_up_ms", static_cast<long long>(model->warm_up_ms + 0.5)}});
 }
 
 std::chrono::milliseconds Milliseconds(double seconds) {

@@ -61,7 +61,8 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
                                           const EdgeBoxParams& box_params, int k, bool multistride,
                                           const SizeFilter* size_filter, EdgeBoxStats* stats) {
   if (stats != nullptr) *stats = EdgeBoxStats{};
-  const cv::Mat1f map = RegionEdgeMap(oaocc, regions, k);
+  // Normalised straight from the region's copy: one map is held while the windows are scored.
+  const cv::Mat1f map = NormaliseToMax(RegionEdgeMap(oaocc, regions, k));
   if (map.empty()) return {};
   const EdgeBoxParams params = RegionBoxParams(box_params, k, regions.num_layers(), multistride);
   const Box region = Intersect(regions.layers[k], oaocc.r1);
@@ -72,8 +73,7 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
   // take places under max_boxes.
   std::optional<WindowAdmission> admission;
   if (filtered) admission.emplace(*size_filter, region.y);
-  for (ScoredBox b :
-       ScoreEdgeBoxes(NormaliseToMax(map), params, stats, admission ? &*admission : nullptr)) {
+  for (ScoredBox b : ScoreEdgeBoxes(map, params, stats, admission ? &*admission : nullptr)) {
     b.box.x += region.x;
     b.box.y += region.y;
     if (filtered && !size_filter->Keep(b.box)) continue;

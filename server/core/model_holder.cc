@@ -2,6 +2,8 @@
 
 #include <ctime>
 
+#include "core/pipeline/warm_up.h"
+
 namespace tod::server {
 
 std::string UtcNowIso8601() {
@@ -18,17 +20,21 @@ Status ModelHolder::Load(const std::string& model_dir) {
   Result<std::shared_ptr<const Detector>> detector = Detector::Load(model_dir);
   if (!detector.ok()) return detector.status();
   if (*detector == nullptr) return Status::Internal("model loader returned no detector");
-  Publish(std::move(*detector), model_dir);
+  const Result<double> warm_up_ms = WarmUp(**detector);
+  if (!warm_up_ms.ok()) return warm_up_ms.status().WithContext(model_dir);
+  Publish(std::move(*detector), model_dir, *warm_up_ms);
   return Status::Ok();
 }
 
 void ModelHolder::Install(std::shared_ptr<const Detector> detector, const std::string& model_dir) {
   std::lock_guard load_lock(load_mutex_);
-  Publish(std::move(detector), model_dir);
+  Publish(std::move(detector), model_dir, /*warm_up_ms=*/0);
 }
 
-void ModelHolder::Publish(std::shared_ptr<const Detector> detector, const std::string& model_dir) {
+void ModelHolder::Publish(std::shared_ptr<const Detector> detector, const std::string& model_dir,
+                          double warm_up_ms) {
   auto model = std::make_shared<LoadedModel>();
+  model->warm_up_ms = warm_up_ms;
   model->detector = std::move(detector);
   model->model_dir = model_dir;
   model->loaded_at = UtcNowIso8601();

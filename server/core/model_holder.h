@@ -16,11 +16,14 @@ struct LoadedModel {
   std::string model_dir;
   int generation = 0;     // 1 for the first load, +1 per successful reload
   std::string loaded_at;  // ISO 8601 UTC
+  double warm_up_ms = 0;  // the warm-up detection run before it was published (warm_up.h)
 };
 
 class ModelHolder {
  public:
-  // Loads `model_dir` with Detector::Load; on failure the current model (if any) stays.
+  // Loads `model_dir` with Detector::Load and warms it up (one detection on a made-up frame, so
+  // no request pays the process's one-off costs) before it becomes current; on failure the
+  // current model (if any) stays.
   Status Load(const std::string& model_dir);
   // Serves an already constructed detector (embedding, tests); `model_dir` is what Reload() reads.
   void Install(std::shared_ptr<const Detector> detector, const std::string& model_dir);
@@ -31,7 +34,8 @@ class ModelHolder {
 
  private:
   // Makes `detector` current with the next generation number; load_mutex_ must be held.
-  void Publish(std::shared_ptr<const Detector> detector, const std::string& model_dir);
+  void Publish(std::shared_ptr<const Detector> detector, const std::string& model_dir,
+               double warm_up_ms);
 
   mutable std::mutex mutex_;  // guards current_; loading happens outside it
   std::mutex load_mutex_;     // one load at a time, so generations are sequential

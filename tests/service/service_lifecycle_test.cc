@@ -202,6 +202,8 @@ TEST(ServiceLifecycleTest, SighupReloadsGoodBundleAndRefusesBrokenOne) {
   ASSERT_TRUE(client.GetModelInfo(&info).ok());
   EXPECT_EQ(info.generation(), 1);
   const std::string first_load = info.loaded_at();
+  // The model was warmed up (one detection on a made-up frame) before the server said ready.
+  EXPECT_NE(server->Log().find("warm_up_ms="), std::string::npos) << server->Log();
 
   server->Signal(SIGHUP);
   ASSERT_TRUE(WaitForMetric(server->http_port(), R"(tod_model_reloads_total{result="success"})", 1))
