@@ -13,6 +13,7 @@
 int main(int argc, char** argv) {
   tod::server::BlockServerSignals();
   tod::RetainLargeAllocations();  // workers run the pipeline frame after frame
+  tod::ShareOneHeapArena();       // ... and one worker reuses what another freed
   CLI::App app{"tod_server: tiny obstacle discovery over gRPC and REST"};
   std::map<std::string, std::string> flags;
   std::string config_file;

@@ -23,4 +23,13 @@ bool RetainLargeAllocations() {
 #endif
 }
 
+bool ShareOneHeapArena() {
+#if defined(__GLIBC__)
+  if (std::getenv("MALLOC_ARENA_MAX") != nullptr) return false;  // the operator's choice
+  return mallopt(M_ARENA_MAX, 1) == 1;
+#else
+  return false;
+#endif
+}
+
 }  // namespace tod
