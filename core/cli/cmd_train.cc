@@ -1,7 +1,10 @@
 // tod train --data DIR --out MODEL_DIR [--regions auto|laf2020] [--seed S] [--format ...]
 // Trains every learned part on the train split, writes the bundle atomically, then (unless
 // --no-eval) evaluates it on the test split and stores the numbers in its manifest.
+#include <algorithm>
+#include <cmath>
 #include <iostream>
+#include <vector>
 
 #include "core/cli/commands.h"
 #include "core/pipeline/evaluator.h"
@@ -20,6 +23,7 @@ Runner AddTrainCommand(CLI::App& app) {
     std::string eval_split = "test";
     int eval_frames = 0;
     int trees = 200;
+    double negatives_scale = 1.0;
     std::string on_bad_frame = "fail";
   };
   auto args = std::make_shared<Args>();
@@ -49,6 +53,10 @@ Runner AddTrainCommand(CLI::App& app) {
                   "frames for the edge and occlusion classifiers");
   cmd->add_option("--trees", args->trees, "trees per regressor (paper: 200)")
       ->check(CLI::Range(1, 2000));
+  cmd->add_option("--negatives-scale", args->negatives_scale,
+                  "regressor negatives per frame and vertical range, as a multiple of the "
+                  "paper's (ORDR 17, OBDR 25)")
+      ->check(CLI::Range(0.1, 20.0));
   cmd->add_option("--edge-trees", args->train.edge_params.forest.num_trees,
                   "trees of the pixel edge classifier")
       ->check(CLI::Range(1, 200));
@@ -93,6 +101,11 @@ Runner AddTrainCommand(CLI::App& app) {
     options.on_bad_frame = *ParseBadFramePolicy(args->on_bad_frame);  // checked by CLI11
     if (!options.sed_model.empty() && options.edge_source != "sed") options.edge_source = "sed";
     options.regressor.num_trees = args->trees;
+    for (std::vector<int>* counts :
+         {&options.selection.ordr_negatives, &options.selection.obdr_negatives}) {
+      for (int& n : *counts)
+        n = std::max(1, static_cast<int>(std::lround(n * args->negatives_scale)));
+    }
     options.params.size_filter = !args->no_size_filter;
     if (args->refine_all) {
       options.params.boxes.refine_local_maxima = false;

@@ -682,15 +682,18 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   const Regressors& regressors = trained->regressors;  // its sample counts
   const ForestParams forest = RegressorForest(options);
   for (const char* name : {"ordr", "obdr"})
-    parts[name] = {{"learned", true},
-                   {"trained", true},
-                   {"samples", std::string(name) == "ordr" ? regressors.ordr_samples
-                                                           : regressors.obdr_samples},
-                   {"trees", forest.num_trees},
-                   {"mtry", forest.max_features},
-                   {"min_leaf", forest.min_leaf_size},
-                   {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"},
-                   {"maps", folds.enabled ? "out_of_fold" : "in_sample"}};
+    parts[name] = {
+        {"learned", true},
+        {"trained", true},
+        {"samples",
+         std::string(name) == "ordr" ? regressors.ordr_samples : regressors.obdr_samples},
+        {"trees", forest.num_trees},
+        {"mtry", forest.max_features},
+        {"min_leaf", forest.min_leaf_size},
+        {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"},
+        {"negatives_per_range", std::string(name) == "ordr" ? options.selection.ordr_negatives
+                                                            : options.selection.obdr_negatives},
+        {"maps", folds.enabled ? "out_of_fold" : "in_sample"}};
 
   run.StartStep();
   run.Say("calibrating obstacle scores (2-fold)");

@@ -159,15 +159,25 @@ TEST_F(MasksCliTest, HardNegativeMiningByDefaultOneRoundOnRequest) {
 // any work.
 TEST_F(MasksCliTest, ClassifierTreeCountsAreChoicesAndRecorded) {
   const std::string model = (out_ / "trees").string();
-  const CommandResult run = RunCommand(Train(model, "--edge-trees 4 --occlusion-trees 12"));
+  const CommandResult run =
+      RunCommand(Train(model, "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json manifest = Manifest(model);
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 4);
   EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 12);
-  const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), "--edge-trees 0"));
-  EXPECT_NE(wrong.exit_code, 0);
-  EXPECT_NE(wrong.output.find("--edge-trees"), std::string::npos) << wrong.output;
-  EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
+  // The regressors' negatives per frame and range: twice the paper's 17 (ORDR) and 25 (OBDR).
+  EXPECT_EQ(manifest["training"]["parts"]["ordr"]["negatives_per_range"],
+            nlohmann::json({34, 34, 34, 34}));
+  EXPECT_EQ(manifest["training"]["parts"]["obdr"]["negatives_per_range"],
+            nlohmann::json({50, 50, 50, 50}));
+  for (const char* flag : {"--edge-trees 0", "--negatives-scale 0"}) {
+    const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), flag));
+    EXPECT_NE(wrong.exit_code, 0) << flag;
+    EXPECT_NE(wrong.output.find(std::string(flag).substr(0, std::string(flag).find(' '))),
+              std::string::npos)
+        << wrong.output;
+    EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
+  }
 }
 
 // --size-filter-recipe bands restores the authors' per-band extremes (three bands); the manifest
