@@ -15,7 +15,7 @@ bool RetainLargeAllocations();
 // thread. With RetainLargeAllocations each arena keeps the peak of the frames its threads ran, so
 // a server of W workers held W frame peaks side by side although they rarely coincide; one shared
 // heap lets a worker reuse the pages another has freed. Measured with `tod_server --workers 2`
-// after 550 real and synthetic requests (deploy/bench_server.sh): peak RSS 405 -> 315 MB with the
+// after 550 real and synthetic requests (deploy/bench_server.sh): peak RSS 405 -> 315-330 MB, the
 // same throughput. For the server, whose workers allocate a few large blocks per stage; not for
 // the trainer's many small per-frame allocations. A MALLOC_ARENA_MAX in the environment wins:
 // then nothing is changed and this returns false, as it does where the C library refuses.
