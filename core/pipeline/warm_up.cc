@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <opencv2/imgproc.hpp>
-#include <string>
 
 namespace tod {
 

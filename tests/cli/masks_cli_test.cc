@@ -157,7 +157,7 @@ TEST_F(MasksCliTest, HardNegativeMiningByDefaultOneRoundOnRequest) {
 
 // The classifiers' tree counts are choices the manifest records; out of range is refused before
 // any work.
-TEST_F(MasksCliTest, ClassifierTreeCountsAreChoicesAndRecorded) {
+TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   const std::string model = (out_ / "trees").string();
   const CommandResult run =
       RunCommand(Train(model, "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2"));
