@@ -235,9 +235,8 @@ Result<OcclusionClassifier> OcclusionClassifier::Fit(
   return FitOnSamples(std::move(all), params);
 }
 
-Result<cv::Mat1f> OcclusionClassifier::PaintChecked(const cv::Mat3b& image,
-                                                    const cv::Mat1f& enhanced_edge,
-                                                    const Superpixels& superpixels) const {
+Result<cv::Mat1f> OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
+                                             const Superpixels& superpixels) const {
   if (Status s = ValidateMaps(image, enhanced_edge, superpixels, "occlusion paint"); !s.ok()) {
     return s;
   }
@@ -276,13 +275,6 @@ Result<cv::Mat1f> OcclusionClassifier::PaintChecked(const cv::Mat3b& image,
     out[pairs.boundary_pixels[i]] = value;
   }
   return painted;
-}
-
-cv::Mat1f OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                                     const Superpixels& superpixels) const {
-  Result<cv::Mat1f> painted = PaintChecked(image, enhanced_edge, superpixels);
-  if (!painted.ok()) return cv::Mat1f();
-  return std::move(painted).value();
 }
 
 // The file: header (binary_io.h), u32 feature count, the parameters (f32 floor, f64

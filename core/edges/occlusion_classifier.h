@@ -61,12 +61,9 @@ class OcclusionClassifier {
   double sampled_odds_scale() const { return sampled_odds_scale_; }
 
   // Occlusion edge map on the crop: boundary pixels carry the max pair probability (>= floor),
-  // all other pixels 0. Returns an empty map when the inputs disagree in size.
-  cv::Mat1f Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                  const Superpixels& superpixels) const;
-  // As Paint, with the reason when the inputs are rejected.
-  Result<cv::Mat1f> PaintChecked(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                                 const Superpixels& superpixels) const;
+  // all other pixels 0. Inputs that disagree in size or labels out of range are an error.
+  Result<cv::Mat1f> Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
+                          const Superpixels& superpixels) const;
 
   // The file format is in occlusion_classifier.cc; Load's errors name the reader's source.
   Status Save(BinaryWriter& out) const;

@@ -59,8 +59,8 @@ Status ValidateSuperpixelInput(const cv::Mat3b& bgr, const cv::Mat1f& edge,
   return Status::Ok();
 }
 
-Result<Superpixels> ComputeStickySuperpixelsChecked(const cv::Mat3b& bgr, const cv::Mat1f& edge,
-                                                    const StickySuperpixelParams& params) {
+Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat1f& edge,
+                                             const StickySuperpixelParams& params) {
   if (Status status = ValidateSuperpixelInput(bgr, edge, params); !status.ok()) return status;
   const int width = bgr.cols;
   const int height = bgr.rows;
@@ -112,13 +112,6 @@ Result<Superpixels> ComputeStickySuperpixelsChecked(const cv::Mat3b& bgr, const 
   InsertSuperpixelBoundaries(edge_full, result.labels);
   result.count = CompactLabels(result.labels);
   return result;
-}
-
-Superpixels ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat1f& edge,
-                                     const StickySuperpixelParams& params) {
-  Result<Superpixels> result = ComputeStickySuperpixelsChecked(bgr, edge, params);
-  if (!result.ok()) return Superpixels{};
-  return std::move(result).value();
 }
 
 }  // namespace tod

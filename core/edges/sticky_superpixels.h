@@ -20,15 +20,10 @@ struct Superpixels {
   int count = 0;
 };
 
-// bgr: crop; edge: enhanced edge map Ê of the same size (values may exceed 1).
-// On invalid input (see ValidateSuperpixelInput) returns an empty Superpixels (count 0, no
-// labels); use ComputeStickySuperpixelsChecked to learn why.
-Superpixels ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat1f& edge,
-                                     const StickySuperpixelParams& params = {});
-
-// Same, with the reason when the input is rejected.
-Result<Superpixels> ComputeStickySuperpixelsChecked(const cv::Mat3b& bgr, const cv::Mat1f& edge,
-                                                    const StickySuperpixelParams& params = {});
+// bgr: crop; edge: enhanced edge map Ê of the same size (values may exceed 1). Invalid input (see
+// ValidateSuperpixelInput) is an error that names the reason.
+Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat1f& edge,
+                                             const StickySuperpixelParams& params = {});
 
 // Non-empty image, edge map of the same size and finite, k > 0, alpha and beta in [0,1],
 // iterations >= 0.

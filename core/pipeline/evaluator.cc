@@ -102,9 +102,11 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const OcclusionClassifier untrained_boundaries;
     PipelineParams plain_params = bundle.params;
     plain_params.prior_correction.occlusion_odds = 1.0;  // mean E is no classifier probability
-    const OcclusionEdges plain =
+    const Result<OcclusionEdges> plain_computed =
         ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &untrained_boundaries,
                               plain_params, /*enhance=*/false);
+    if (!plain_computed.ok()) return plain_computed.status();
+    const OcclusionEdges& plain = *plain_computed;
     const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1, kMaxProposals);
     const ProposalSet olp1 = ProposeBoxes(
         plain, geo.regions, bundle.params.boxes,
@@ -112,9 +114,11 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
 
     // The detector's own path (timed): enhanced edges, BP = OAOCC+OLP@4+MS, regression, map.
     StageTimer timer;
-    const OcclusionEdges oaocc =
+    const Result<OcclusionEdges> computed =
         ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion, bundle.params,
                               /*enhance=*/true, &timer);
+    if (!computed.ok()) return computed.status();
+    const OcclusionEdges& oaocc = *computed;
     const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
     std::vector<std::vector<ScoredBox>> ms_regions;
     for (int k = 0; k < layers; ++k)

@@ -53,11 +53,13 @@ std::string ContractName(const std::string& detector_stage) {
 
 // The work counters and the Edge Boxes baseline, on a separate pass with the detector's own
 // stage calls and parameters (ObstacleDetector::Detect), so the timed call carries no counting.
-void CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchRecord& record) {
+Status CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchRecord& record) {
   const FrameGeometry geometry = GeometryForFrame(bundle, bgr.cols, bgr.rows);
-  const OcclusionEdges oaocc =
+  const Result<OcclusionEdges> computed =
       ComputeOcclusionEdges(bgr, geometry.regions, *bundle.edges, &bundle.occlusion, bundle.params,
                             /*enhance=*/true);
+  if (!computed.ok()) return computed.status().WithContext("counting the work");
+  const OcclusionEdges& oaocc = *computed;
   const SizeFilter* size_filter = bundle.params.size_filter ? &geometry.size_filter : nullptr;
   std::vector<std::vector<ScoredBox>> per_region;
   for (int k = 0; k < geometry.regions.num_layers(); ++k) {
@@ -79,6 +81,7 @@ void CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchRecord
   const std::vector<Box> boxes = EdgeBoxesBaseline(oaocc.base_edge, oaocc.r1, kEdgeBoxesMax);
   record.edgeboxes_ms = MsBetween(start, Clock::now());
   record.edgeboxes_boxes = static_cast<long long>(boxes.size());
+  return Status::Ok();
 }
 
 // The timed part: decode, the detector's call exactly as `tod detect` makes it, and the map
@@ -124,7 +127,7 @@ Result<FrameBenchRecord> MeasureFrame(const ObstacleDetector& detector, const st
   auto record = TimeFrame(detector, *bytes, options, bgr);
   if (!record.ok()) return record.status();
   record->frame = path;
-  CountWork(detector.bundle(), bgr, *record);
+  if (Status counted = CountWork(detector.bundle(), bgr, *record); !counted.ok()) return counted;
   return record;
 }
 

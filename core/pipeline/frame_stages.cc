@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "core/pipeline/frame_budget.h"
 #include "core/pipeline/pipeline_params.h"
@@ -11,10 +12,12 @@
 
 namespace tod {
 
-OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerRegions& regions,
-                                     const EdgeSource& edges, const OcclusionClassifier* classifier,
-                                     const PipelineParams& params, bool enhance,
-                                     StageTimer* timer) {
+Result<OcclusionEdges> ComputeOcclusionEdges(const cv::Mat3b& image,
+                                             const MultilayerRegions& regions,
+                                             const EdgeSource& edges,
+                                             const OcclusionClassifier* classifier,
+                                             const PipelineParams& params, bool enhance,
+                                             StageTimer* timer) {
   // Marks a stage boundary; true when the timer's check asks to stop here.
   auto mark = [timer](const char* stage) {
     if (timer != nullptr) timer->Mark(stage);
@@ -37,10 +40,15 @@ OcclusionEdges ComputeOcclusionEdges(const cv::Mat3b& image, const MultilayerReg
     }
   }
   if (mark("edges")) return out;
-  out.superpixels = ComputeStickySuperpixels(out.crop, out.enhanced, params.superpixels);
+  Result<Superpixels> superpixels =
+      ComputeStickySuperpixels(out.crop, out.enhanced, params.superpixels);
+  if (!superpixels.ok()) return superpixels.status();
+  out.superpixels = std::move(superpixels).value();
   if (mark("superpixels")) return out;
   if (classifier != nullptr) {
-    out.occlusion = classifier->Paint(out.crop, out.enhanced, out.superpixels);
+    Result<cv::Mat1f> occlusion = classifier->Paint(out.crop, out.enhanced, out.superpixels);
+    if (!occlusion.ok()) return occlusion.status();
+    out.occlusion = std::move(occlusion).value();
     CorrectSampledPrior(out.occlusion, params.prior_correction.occlusion_odds);
     (void)mark("occlusion");  // the caller checks timer->stopped() after the last stage
   }

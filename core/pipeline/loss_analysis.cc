@@ -6,6 +6,7 @@
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <utility>
 
 #include "core/features/sample_selection.h"
 #include "core/pipeline/dataset_factory.h"
@@ -65,12 +66,14 @@ struct FrameResult {
   std::vector<ObstacleFate> fates;
 };
 
-FrameResult AnalyseFrame(const ModelBundle& bundle, const Sample& s,
-                         const LossAnalysisOptions& options) {
+Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
+                                 const LossAnalysisOptions& options) {
   FrameResult out;
   const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
-  const OcclusionEdges oaocc = ComputeOcclusionEdges(
+  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
       s.image, geo.regions, *bundle.edges, &bundle.occlusion, bundle.params, /*enhance=*/true);
+  if (!computed.ok()) return computed.status();
+  const OcclusionEdges& oaocc = *computed;
   const int layers = geo.regions.num_layers();
   std::vector<ScoredBox> unfiltered;
   std::vector<std::vector<ScoredBox>> filtered(layers);
@@ -148,7 +151,9 @@ Result<LossAnalysis> AnalyseLosses(const ModelBundle& bundle, const LossAnalysis
   const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
     auto sample = selection->dataset->Load(selection->frames[i]);
     if (!sample.ok()) return sample.status();
-    results[i] = AnalyseFrame(bundle, *sample, options);
+    Result<FrameResult> result = AnalyseFrame(bundle, *sample, options);
+    if (!result.ok()) return result.status();
+    results[i] = std::move(result).value();
     std::lock_guard lock(mutex);
     ++done;
     if (options.progress && (done % 5 == 0 || done == n))

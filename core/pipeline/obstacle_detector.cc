@@ -79,10 +79,12 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   const FrameBudget budget(std::chrono::steady_clock::now(), options.budget_ms);
   const int threads = std::max(1, options.threads);
   const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
-  const OcclusionEdges oaocc = ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges,
-                                                     &bundle_.occlusion, bundle_.params,
-                                                     /*enhance=*/true, &timer);
+  const Result<OcclusionEdges> computed =
+      ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges, &bundle_.occlusion,
+                            bundle_.params, /*enhance=*/true, &timer);
+  if (!computed.ok()) return computed.status();
   if (!timer.stopped().ok()) return timer.stopped();
+  const OcclusionEdges& oaocc = *computed;
   // E and Ê are not read after this point, but they stay until the frame ends: released here
   // they left a hole the proposal stage's larger tables could not use, and the process's peak
   // RSS over 20 real frames rose 190 -> 199 MB although the live heap's peak fell.

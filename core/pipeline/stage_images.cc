@@ -150,8 +150,10 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
   if (layers == 0 || ClipToImage(regions.layers.front(), bgr.cols, bgr.rows).empty())
     return Status::InvalidArgument("the bundle's R1 does not cover the frame");
   // The detector's own stage calls (ObstacleDetector::Detect).
-  const OcclusionEdges oaocc = ComputeOcclusionEdges(bgr, regions, *bundle.edges, &bundle.occlusion,
-                                                     bundle.params, /*enhance=*/true);
+  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
+      bgr, regions, *bundle.edges, &bundle.occlusion, bundle.params, /*enhance=*/true);
+  if (!computed.ok()) return computed.status();
+  const OcclusionEdges& oaocc = *computed;
   const SizeFilter* size_filter = bundle.params.size_filter ? &geometry.size_filter : nullptr;
 
   StageImages out;

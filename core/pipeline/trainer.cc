@@ -361,8 +361,10 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
   std::vector<OcclusionSamples> per_frame(run.num_frames());
   const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
     const ModelBundle& upstream = folds.For(bundle, i);
-    const OcclusionEdges oaocc = ComputeOcclusionEdges(s.image, bundle.regions, *upstream.edges,
-                                                       nullptr, upstream.params, /*enhance=*/true);
+    const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
+        s.image, bundle.regions, *upstream.edges, nullptr, upstream.params, /*enhance=*/true);
+    if (!computed.ok()) return computed.status();
+    const OcclusionEdges& oaocc = *computed;
     const OcclusionTrainingFrame frame{oaocc.crop, oaocc.enhanced, oaocc.superpixels,
                                        LabelMap(s)(oaocc.r1.rect()).clone()};
     auto samples = ExtractOcclusionSamples(frame, params, static_cast<std::size_t>(i));
@@ -442,8 +444,10 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
       run.FirstError(survey.usable, run.ForEachFrame(survey.usable, [&](int i, const Sample& s) {
         if (cv::countNonZero(s.road) > 0) {
           const ModelBundle& upstream = folds.For(bundle, i);
-          const OcclusionEdges oaocc = ComputeOcclusionEdges(
+          const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
               s.image, bundle.regions, *upstream.edges, &upstream.occlusion, upstream.params, true);
+          if (!computed.ok()) return computed.status();
+          const OcclusionEdges& oaocc = *computed;
           const ProposalSet all =
               ProposeBoxes(oaocc, bundle.regions, bundle.params.boxes,
                            DetectorProposalOptions(bundle.params, bundle.regions.num_layers()),

@@ -93,7 +93,7 @@ int main() {
     tod::OcclusionTrainingFrame f;
     f.image = small.image;
     f.enhanced_edge = EnhancedEdge(small.image);
-    f.superpixels = tod::ComputeStickySuperpixels(f.image, f.enhanced_edge);
+    f.superpixels = std::move(tod::ComputeStickySuperpixels(f.image, f.enhanced_edge)).value();
     f.labels = small.labels;
     frames.push_back(f);
   }
@@ -109,10 +109,11 @@ int main() {
     StickySuperpixelParams sp_params;
     sp_params.k = k;
     Superpixels sp;
-    const double sp_ms =
-        MedianMs(kRuns, [&] { sp = tod::ComputeStickySuperpixels(scene.image, edge, sp_params); });
-    const double fb_ms = MedianMs(kRuns, [&] { fallback.Paint(scene.image, edge, sp); });
-    const double forest_ms = MedianMs(kRuns, [&] { trained.Paint(scene.image, edge, sp); });
+    const double sp_ms = MedianMs(kRuns, [&] {
+      sp = std::move(tod::ComputeStickySuperpixels(scene.image, edge, sp_params)).value();
+    });
+    const double fb_ms = MedianMs(kRuns, [&] { (void)fallback.Paint(scene.image, edge, sp); });
+    const double forest_ms = MedianMs(kRuns, [&] { (void)trained.Paint(scene.image, edge, sp); });
     std::printf("%-8d %-14d %10.1f %14.1f %18.1f %16d\n", k, sp.count, sp_ms, fb_ms, forest_ms,
                 cv::countNonZero(sp.labels == 0));
   }

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <iostream>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -89,8 +90,13 @@ int main(int argc, char** argv) {
   std::vector<cv::Size> region_sizes(static_cast<size_t>(layers));
   for (int f = 0; f < frames; ++f) {
     const tod::Sample frame = tod::GenerateSynthFrame(synth, 1000 + static_cast<unsigned>(f), "b");
-    const tod::OcclusionEdges oaocc = tod::ComputeOcclusionEdges(
+    const tod::Result<tod::OcclusionEdges> computed = tod::ComputeOcclusionEdges(
         frame.image, geometry.regions, *bundle->edges, &bundle->occlusion, bundle->params, true);
+    if (!computed.ok()) {
+      std::cerr << computed.status().ToString() << "\n";
+      return 1;
+    }
+    const tod::OcclusionEdges& oaocc = *computed;
     std::vector<double> frame_ms(configs.size(), 0.0);
     for (int k = 0; k < layers; ++k) {
       const cv::Mat1f map = tod::NormaliseToMax(tod::RegionEdgeMap(oaocc, geometry.regions, k));

@@ -16,6 +16,14 @@
 namespace tod {
 namespace {
 
+// The occlusion map of inputs the test knows to be valid (an error fails the test).
+cv::Mat1f Painted(const OcclusionClassifier& classifier, const cv::Mat3b& image,
+                  const cv::Mat1f& enhanced_edge, const Superpixels& superpixels) {
+  Result<cv::Mat1f> painted = classifier.Paint(image, enhanced_edge, superpixels);
+  EXPECT_TRUE(painted.ok()) << painted.status().ToString();
+  return painted.ok() ? std::move(painted).value() : cv::Mat1f();
+}
+
 // Three vertical stripes of superpixels separated by 1-pixel boundary columns 2 and 5:
 // labels per row = 1 1 0 2 2 0 3 3; Ê = 0.2 on column 2 and 0.8 on column 5.
 struct StripeScene {
@@ -215,7 +223,7 @@ TEST(OcclusionClassifierTest, UntrainedPaintsRescaledMeanEdge) {
   const StripeScene s = MakeStripes();
   const OcclusionClassifier classifier;
   ASSERT_FALSE(classifier.trained());
-  const cv::Mat1f painted = classifier.Paint(s.image, s.edge, s.superpixels);
+  const cv::Mat1f painted = Painted(classifier, s.image, s.edge, s.superpixels);
   ASSERT_EQ(painted.size(), s.image.size());
   for (int y = 0; y < 4; ++y) {
     for (int x = 0; x < 8; ++x) {
@@ -228,7 +236,7 @@ TEST(OcclusionClassifierTest, UntrainedPaintsRescaledMeanEdge) {
 TEST(OcclusionClassifierTest, UntrainedFlatEdgeGivesFloor) {
   StripeScene s = MakeStripes();
   s.edge.setTo(0.f);
-  const cv::Mat1f painted = OcclusionClassifier().Paint(s.image, s.edge, s.superpixels);
+  const cv::Mat1f painted = Painted(OcclusionClassifier(), s.image, s.edge, s.superpixels);
   EXPECT_FLOAT_EQ(painted(0, 2), OcclusionParams{}.floor);
   EXPECT_FLOAT_EQ(painted(3, 5), OcclusionParams{}.floor);
   EXPECT_FLOAT_EQ(painted(1, 1), 0.f);
@@ -237,15 +245,13 @@ TEST(OcclusionClassifierTest, UntrainedFlatEdgeGivesFloor) {
 TEST(OcclusionClassifierTest, RejectsMismatchedInputs) {
   const StripeScene s = MakeStripes();
   const OcclusionClassifier classifier;
-  const Result<cv::Mat1f> bad =
-      classifier.PaintChecked(s.image, cv::Mat1f(4, 7, 0.f), s.superpixels);
+  const Result<cv::Mat1f> bad = classifier.Paint(s.image, cv::Mat1f(4, 7, 0.f), s.superpixels);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("enhanced_edge"), std::string::npos);
-  EXPECT_TRUE(classifier.Paint(s.image, cv::Mat1f(4, 7, 0.f), s.superpixels).empty());
 
   Superpixels out_of_range = s.superpixels;
   out_of_range.count = 2;  // label 3 is present
-  EXPECT_FALSE(classifier.PaintChecked(s.image, s.edge, out_of_range).ok());
+  EXPECT_FALSE(classifier.Paint(s.image, s.edge, out_of_range).ok());
 }
 
 // ---- Training on synthetic frames -----------------------------------------------------------
@@ -315,7 +321,10 @@ SyntheticFrame MakeFrame(int seed) {
   s.frame.enhanced_edge = GradientEdge(image);
   StickySuperpixelParams sp_params;
   sp_params.k = 256;
-  s.frame.superpixels = ComputeStickySuperpixels(image, s.frame.enhanced_edge, sp_params);
+  Result<Superpixels> superpixels =
+      ComputeStickySuperpixels(image, s.frame.enhanced_edge, sp_params);
+  EXPECT_TRUE(superpixels.ok()) << superpixels.status().ToString();
+  if (superpixels.ok()) s.frame.superpixels = std::move(superpixels).value();
   s.frame.labels = labels;
   cv::Mat1b near_objects;
   cv::dilate(objects, near_objects, cv::Mat(), cv::Point(-1, -1), 4);
@@ -362,7 +371,7 @@ TEST_F(TrainedOcclusionTest, ObjectContoursBeatRoadTexture) {
   ASSERT_TRUE(classifier_->trained());
   const SyntheticFrame test = MakeFrame(99);  // not seen in training
   const OcclusionTrainingFrame& f = test.frame;
-  const cv::Mat1f painted = classifier_->Paint(f.image, f.enhanced_edge, f.superpixels);
+  const cv::Mat1f painted = Painted(*classifier_, f.image, f.enhanced_edge, f.superpixels);
   const double object = MeanOver(painted, test.object_contour, f.superpixels.labels);
   const double texture = MeanOver(painted, test.texture_contour, f.superpixels.labels);
   RecordProperty("object", std::to_string(object));
@@ -370,7 +379,8 @@ TEST_F(TrainedOcclusionTest, ObjectContoursBeatRoadTexture) {
   EXPECT_GT(object, texture + 0.2) << "object " << object << " texture " << texture;
 
   // The untrained fallback cannot tell them apart this well: texture edges are stronger.
-  const cv::Mat1f fallback = OcclusionClassifier().Paint(f.image, f.enhanced_edge, f.superpixels);
+  const cv::Mat1f fallback =
+      Painted(OcclusionClassifier(), f.image, f.enhanced_edge, f.superpixels);
   const double fallback_object = MeanOver(fallback, test.object_contour, f.superpixels.labels);
   const double fallback_texture = MeanOver(fallback, test.texture_contour, f.superpixels.labels);
   RecordProperty("fallback_object", std::to_string(fallback_object));
@@ -383,7 +393,7 @@ TEST_F(TrainedOcclusionTest, PaintOnlyOnBoundariesAndAtLeastFloor) {
   const OcclusionTrainingFrame& f = test.frame;
   const OcclusionClassifier fallback;
   for (const OcclusionClassifier* c : {classifier_, &fallback}) {
-    const cv::Mat1f painted = c->Paint(f.image, f.enhanced_edge, f.superpixels);
+    const cv::Mat1f painted = Painted(*c, f.image, f.enhanced_edge, f.superpixels);
     ASSERT_EQ(painted.size(), f.image.size());
     const cv::Mat1b boundary = f.superpixels.labels == 0;
     EXPECT_EQ(cv::countNonZero((painted != 0) != boundary), 0);
@@ -404,8 +414,8 @@ TEST_F(TrainedOcclusionTest, SaveLoadRoundTrip) {
   EXPECT_EQ(loaded->params().forest.num_trees, 20);
   const SyntheticFrame test = MakeFrame(5);
   const OcclusionTrainingFrame& f = test.frame;
-  const cv::Mat1f a = classifier_->Paint(f.image, f.enhanced_edge, f.superpixels);
-  const cv::Mat1f b = loaded->Paint(f.image, f.enhanced_edge, f.superpixels);
+  const cv::Mat1f a = Painted(*classifier_, f.image, f.enhanced_edge, f.superpixels);
+  const cv::Mat1f b = Painted(*loaded, f.image, f.enhanced_edge, f.superpixels);
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
 }
 

@@ -86,8 +86,10 @@ TEST_F(DetectBudgetTest, AnExhaustedBudgetDegradesTheProposalsAndSaysSo) {
 TEST_F(DetectBudgetTest, RegressionPastItsDeadlineDropsTheUnscoredProposals) {
   const FrameGeometry geometry = GeometryForFrame(detector_->bundle(), frame_.cols, frame_.rows);
   const ModelBundle& bundle = detector_->bundle();
-  const OcclusionEdges oaocc = ComputeOcclusionEdges(frame_, geometry.regions, *bundle.edges,
-                                                     &bundle.occlusion, bundle.params, true);
+  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
+      frame_, geometry.regions, *bundle.edges, &bundle.occlusion, bundle.params, true);
+  ASSERT_TRUE(computed.ok()) << computed.status().ToString();
+  const OcclusionEdges& oaocc = *computed;
   const ProposalSet proposals = ProposeBoxes(
       oaocc, geometry.regions, bundle.params.boxes,
       DetectorProposalOptions(bundle.params, geometry.regions.num_layers()), geometry.size_filter);
