@@ -144,12 +144,6 @@ Result<RandomForest> RandomForest::Fit(const cv::Mat1f& features, const std::vec
   return forest;
 }
 
-RandomForest RandomForest::Train(const cv::Mat1f& features, const std::vector<float>& targets,
-                                 const ForestParams& params) {
-  Result<RandomForest> fitted = Fit(features, targets, params);
-  return fitted.ok() ? std::move(fitted).value() : RandomForest();
-}
-
 float RandomForest::Predict(const float* row) const {
   if (tree_roots_.empty()) return 0.f;
   double sum = 0.0;

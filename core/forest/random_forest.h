@@ -29,12 +29,8 @@ struct ForestParams {
 class RandomForest {
  public:
   RandomForest() = default;
-  // features: one row per sample (CV_32F); targets: one per row.
-  // Invalid input (shape mismatch, no rows, non-finite values, bad params) gives an empty forest;
-  // use Fit to learn why.
-  static RandomForest Train(const cv::Mat1f& features, const std::vector<float>& targets,
-                            const ForestParams& params);
-  // As Train, but reports invalid input as a Status naming the offending field.
+  // features: one row per sample (CV_32F); targets: one per row. Invalid input (shape
+  // mismatch, no rows, non-finite values, bad params) is an error naming the offending field.
   static Result<RandomForest> Fit(const cv::Mat1f& features, const std::vector<float>& targets,
                                   const ForestParams& params);
 

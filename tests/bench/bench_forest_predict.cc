@@ -93,8 +93,8 @@ tod::RandomForest TrainOrLoad(const Case& c, const std::string& cache_dir) {
   }
   const Data train = MakeData(c.train_rows, c.features, 1, c.binary);
   tod::RandomForest forest;
-  const double seconds =
-      Seconds([&] { forest = tod::RandomForest::Train(train.x, train.y, c.params); });
+  const double seconds = Seconds(
+      [&] { forest = std::move(tod::RandomForest::Fit(train.x, train.y, c.params)).value(); });
   std::fprintf(stderr, "%s: trained in %.1f s (%lld nodes)\n", c.name.c_str(), seconds,
                static_cast<long long>(forest.num_nodes()));
   if (!path.empty()) {

@@ -74,8 +74,8 @@ void Ours(const Data& train, const Data& test, int threads, Row& row) {
   tod::ForestParams params;  // defaults: 200 trees, mtry 6, min leaf 5, unlimited depth
   params.threads = threads;
   tod::RandomForest forest;
-  row.train_s.push_back(
-      Seconds([&] { forest = tod::RandomForest::Train(train.x, train.y, params); }));
+  row.train_s.push_back(Seconds(
+      [&] { forest = std::move(tod::RandomForest::Fit(train.x, train.y, params)).value(); }));
   std::vector<float> predicted;
   const double predict_s = Seconds([&] { predicted = forest.PredictBatch(test.x); });
   row.predict_ms_per_1000.push_back(1000.0 * predict_s * 1000.0 / test.x.rows);

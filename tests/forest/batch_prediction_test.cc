@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/forest/random_forest.h"
+#include "tests/forest/fitted_forest.h"
 
 namespace tod {
 namespace {
@@ -158,7 +159,7 @@ RandomForest DeepForest() {
   p.max_features = 2;
   p.min_leaf_size = 1;  // deep, unbalanced trees
   p.threads = 1;
-  return RandomForest::Train(train.x, train.y, p);
+  return FittedForest(train.x, train.y, p);
 }
 
 TEST(BatchPrediction, ManyBlocksMatchPredictBitForBit) {
@@ -228,7 +229,7 @@ TEST(BatchPrediction, EveryFeatureWidthMatchesPredict) {
     p.max_features = cols;
     p.min_leaf_size = 1;
     p.threads = 1;
-    const RandomForest forest = RandomForest::Train(train.x, train.y, p);
+    const RandomForest forest = FittedForest(train.x, train.y, p);
     ASSERT_EQ(forest.num_trees(), 4) << cols;
     const Data test = make(77);  // not a multiple of the lane count
     const std::vector<float> batch = forest.PredictBatch(test.x);
@@ -280,7 +281,7 @@ TEST(ScreenedPrediction, TrainedForestGoesOnBitForBitAndStopsAtTheFirstTreesMean
   p.num_trees = 12;
   p.min_leaf_size = 3;
   p.threads = 1;
-  const RandomForest forest = RandomForest::Train(train.x, train.y, p);
+  const RandomForest forest = FittedForest(train.x, train.y, p);
   ASSERT_EQ(forest.num_trees(), 12);
   const Data test = MakeData(20000, 6, 6);
   const std::vector<float> full = forest.PredictBatch(test.x);

@@ -8,6 +8,7 @@
 
 #include "core/base/checksum.h"
 #include "core/forest/random_forest.h"
+#include "tests/forest/fitted_forest.h"
 
 namespace tod {
 namespace {
@@ -26,7 +27,7 @@ RandomForest SmallForest() {
   p.max_features = 2;
   p.min_leaf_size = 8;
   p.threads = 1;
-  return RandomForest::Train(x, y, p);
+  return FittedForest(x, y, p);
 }
 
 std::string Serialise(const RandomForest& forest) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/forest/tree_builder.h"
+#include "tests/forest/fitted_forest.h"
 
 namespace tod {
 namespace {
@@ -52,7 +53,7 @@ TEST(RandomForest, FitsLinearFunction) {
   auto f = [](const float* x) { return x[0] + 2.f * x[1]; };
   const Data train = MakeData(2000, 4, 1, f);
   const Data test = MakeData(500, 4, 2, f);
-  const RandomForest forest = RandomForest::Train(train.x, train.y, SmallParams());
+  const RandomForest forest = FittedForest(train.x, train.y, SmallParams());
   ASSERT_EQ(forest.num_trees(), 40);
   ASSERT_EQ(forest.num_features(), 4);
   // Var(y) = 1/12 + 4/12 ~ 0.417; a forest on 2000 points gets well under 5 % of that.
@@ -63,7 +64,7 @@ TEST(RandomForest, FitsStepFunction) {
   auto f = [](const float* x) { return x[2] > 0.3f ? 5.f : -1.f; };
   const Data train = MakeData(1000, 3, 3, f);
   const Data test = MakeData(300, 3, 4, f);
-  const RandomForest forest = RandomForest::Train(train.x, train.y, SmallParams());
+  const RandomForest forest = FittedForest(train.x, train.y, SmallParams());
   EXPECT_LT(Mse(forest, test), 0.1);  // Var(y) = 36 * 0.21 ~ 7.6
 }
 
@@ -76,7 +77,7 @@ TEST(RandomForest, ClassificationByRegressionOnSeparableData) {
   }
   ForestParams p = SmallParams();
   p.max_features = 3;
-  const RandomForest forest = RandomForest::Train(train.x, train.y, p);
+  const RandomForest forest = FittedForest(train.x, train.y, p);
   const float negative[3] = {0.2f, 0.5f, 0.5f};
   const float positive[3] = {0.8f, 0.5f, 0.5f};
   EXPECT_LT(forest.Predict(negative), 0.05f);
@@ -93,13 +94,13 @@ TEST(RandomForest, SameSeedSamePredictionsRegardlessOfThreads) {
   ForestParams p = SmallParams();
   p.num_trees = 9;
   p.threads = 1;
-  const RandomForest one = RandomForest::Train(train.x, train.y, p);
+  const RandomForest one = FittedForest(train.x, train.y, p);
   p.threads = 2;
-  const RandomForest two = RandomForest::Train(train.x, train.y, p);
+  const RandomForest two = FittedForest(train.x, train.y, p);
   p.threads = 4;
-  const RandomForest four = RandomForest::Train(train.x, train.y, p);
+  const RandomForest four = FittedForest(train.x, train.y, p);
   p.seed = 2;
-  const RandomForest other_seed = RandomForest::Train(train.x, train.y, p);
+  const RandomForest other_seed = FittedForest(train.x, train.y, p);
   int differing = 0;
   for (int r = 0; r < test.x.rows; ++r) {
     const float expected = one.Predict(test.x[r]);
@@ -116,7 +117,7 @@ TEST(RandomForest, FewerSamplesThanMinLeafGivesConstant) {
   const std::vector<float> y = {1, 2, 3, 4};
   ForestParams p = SmallParams();
   p.min_leaf_size = 5;
-  const RandomForest forest = RandomForest::Train(x, y, p);
+  const RandomForest forest = FittedForest(x, y, p);
   ASSERT_FALSE(forest.empty());
   EXPECT_EQ(forest.num_nodes(), forest.num_trees());  // every tree is a single leaf
   const float prediction = forest.Predict(x[0]);
@@ -132,7 +133,7 @@ TEST(RandomForest, LeavesRespectMinLeafSizeAndDepth) {
   ForestParams p = SmallParams();
   p.num_trees = 5;
   p.min_leaf_size = 20;
-  const RandomForest forest = RandomForest::Train(train.x, train.y, p);
+  const RandomForest forest = FittedForest(train.x, train.y, p);
   for (int t = 0; t < forest.num_trees(); ++t) {
     // 200 bootstrap samples, each leaf >= 20 of them: at most 10 leaves; a deep tree uses most.
     EXPECT_LE(forest.CountLeaves(t), 10);
@@ -140,7 +141,7 @@ TEST(RandomForest, LeavesRespectMinLeafSizeAndDepth) {
   }
   p.min_leaf_size = 1;
   p.max_depth = 2;
-  const RandomForest shallow = RandomForest::Train(train.x, train.y, p);
+  const RandomForest shallow = FittedForest(train.x, train.y, p);
   for (int t = 0; t < shallow.num_trees(); ++t) EXPECT_EQ(shallow.CountLeaves(t), 4);
   EXPECT_EQ(shallow.CountLeaves(-1), 0);
   EXPECT_EQ(shallow.CountLeaves(5), 0);
@@ -156,7 +157,7 @@ TEST(RandomForest, SingleFeatureThresholdIsMidway) {
   }
   ForestParams p = SmallParams();
   p.min_leaf_size = 1;
-  const RandomForest forest = RandomForest::Train(x, y, p);
+  const RandomForest forest = FittedForest(x, y, p);
   const float at[4] = {2.49f, 2.5f, 2.51f, 1000.f};
   EXPECT_EQ(forest.Predict(&at[0]), 0.f);
   EXPECT_EQ(forest.Predict(&at[1]), 0.f);
@@ -177,7 +178,7 @@ TEST(RandomForest, BatchMatchesSinglePrediction) {
   const Data test = MakeData(700, 3, 10, [](const float*) { return 0.f; });  // > one block
   ForestParams p = SmallParams();
   p.num_trees = 7;
-  const RandomForest forest = RandomForest::Train(train.x, train.y, p);
+  const RandomForest forest = FittedForest(train.x, train.y, p);
   const std::vector<float> batch = forest.PredictBatch(test.x);
   ASSERT_EQ(batch.size(), 700u);
   for (int r = 0; r < test.x.rows; ++r) EXPECT_EQ(batch[r], forest.Predict(test.x[r]));
@@ -194,11 +195,11 @@ TEST(RandomForest, DefaultMtryIsAThirdOfTheFeatures) {
   const Data test = MakeData(200, 6, 12, f);
   ForestParams p = SmallParams();
   p.max_features = 0;  // floor(6 / 3) = 2
-  const RandomForest default_mtry = RandomForest::Train(train.x, train.y, p);
+  const RandomForest default_mtry = FittedForest(train.x, train.y, p);
   p.max_features = 2;
-  const RandomForest two = RandomForest::Train(train.x, train.y, p);
+  const RandomForest two = FittedForest(train.x, train.y, p);
   p.max_features = 3;
-  const RandomForest three = RandomForest::Train(train.x, train.y, p);
+  const RandomForest three = FittedForest(train.x, train.y, p);
   int differs_from_three = 0;
   for (int r = 0; r < test.x.rows; ++r) {
     EXPECT_EQ(default_mtry.Predict(test.x[r]), two.Predict(test.x[r]));
@@ -247,7 +248,7 @@ TEST(RandomForest, FitRejectsBadInput) {
   bad.max_depth = -1;
   EXPECT_FALSE(RandomForest::Fit(d.x, d.y, bad).ok());
 
-  EXPECT_TRUE(RandomForest::Train(with_nan, d.y, p).empty());
+  EXPECT_FALSE(RandomForest::Fit(with_nan, d.y, p).ok());
   EXPECT_TRUE(RandomForest::Fit(d.x, d.y, p).ok());
 }
 
@@ -258,7 +259,7 @@ TEST(RandomForest, SampleFractionControlsBootstrapSize) {
   p.num_trees = 3;
   p.min_leaf_size = 10;
   p.sample_fraction = 0.1;
-  const RandomForest forest = RandomForest::Train(d.x, d.y, p);
+  const RandomForest forest = FittedForest(d.x, d.y, p);
   for (int t = 0; t < forest.num_trees(); ++t) EXPECT_LE(forest.CountLeaves(t), 2);
 }
 

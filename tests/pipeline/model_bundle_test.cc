@@ -8,6 +8,7 @@
 #include <random>
 
 #include "core/base/binary_io.h"
+#include "tests/forest/fitted_forest.h"
 #include "tests/test_env.h"
 
 namespace tod {
@@ -42,8 +43,8 @@ class ModelBundleTest : public ::testing::Test {
     ForestParams fp;
     fp.num_trees = 5;
     fp.seed = seed;
-    b.ordr = RandomForest::Train(x, y, fp);
-    b.obdr = RandomForest::Train(x, y, fp);
+    b.ordr = FittedForest(x, y, fp);
+    b.obdr = FittedForest(x, y, fp);
     b.version = "test";
     // The occlusion classifier is left untrained here, which a bundle may only ship on purpose.
     b.training = {{"data", "unit test"}, {"parts", {{"occlusion", {{"off", true}}}}}};

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/pipeline/obstacle_detector.h"
+#include "tests/forest/fitted_forest.h"
 
 namespace tod {
 
@@ -32,8 +33,8 @@ inline ModelBundle TinyBundle() {
   ForestParams fp;
   fp.num_trees = 3;
   fp.seed = 5;
-  b.ordr = RandomForest::Train(x, y, fp);
-  b.obdr = RandomForest::Train(x, y, fp);
+  b.ordr = FittedForest(x, y, fp);
+  b.obdr = FittedForest(x, y, fp);
   b.training = {{"data", "unit test"}};
   return b;
 }
