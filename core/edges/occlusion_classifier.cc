@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <opencv2/core/utility.hpp>
 #include <random>
 #include <string_view>
 #include <utility>
@@ -235,6 +236,32 @@ Result<OcclusionClassifier> OcclusionClassifier::Fit(
   return FitOnSamples(std::move(all), params);
 }
 
+namespace {
+
+// Pairs per piece of the forest walk: the batched walk goes over each tree once per piece, so
+// pieces much smaller than this would walk the trees more often than they gain.
+constexpr int kMinPairsPerPiece = 2048;
+
+// The forest's probability for every pair (row of `features`), in contiguous pieces on OpenCV's
+// threads (as many as `--threads-per-request` allows; one piece on one thread). Each row's sum
+// is the same whichever piece walks it, so the result does not depend on the thread count.
+std::vector<float> PairProbabilities(const RandomForest& forest, const cv::Mat1f& features) {
+  const int rows = features.rows;
+  const int pieces = std::clamp(rows / kMinPairsPerPiece, 1, std::max(1, cv::getNumThreads()));
+  if (pieces == 1) return forest.PredictBatch(features);
+  std::vector<float> out(static_cast<std::size_t>(rows));
+  cv::parallel_for_(cv::Range(0, pieces), [&](const cv::Range& range) {
+    for (int p = range.start; p < range.end; ++p) {
+      const int begin = rows * p / pieces, end = rows * (p + 1) / pieces;
+      const std::vector<float> part = forest.PredictBatch(features.rowRange(begin, end));
+      std::copy(part.begin(), part.end(), out.begin() + begin);
+    }
+  });
+  return out;
+}
+
+}  // namespace
+
 Result<cv::Mat1f> OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
                                              const Superpixels& superpixels) const {
   if (Status s = ValidateMaps(image, enhanced_edge, superpixels, "occlusion paint"); !s.ok()) {
@@ -243,7 +270,7 @@ Result<cv::Mat1f> OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::M
   const SuperpixelPairs pairs = ComputeSuperpixelPairs(image, enhanced_edge, superpixels);
   std::vector<float> strength;
   if (trained()) {
-    strength = forest_.PredictBatch(pairs.features);
+    strength = PairProbabilities(forest_, pairs.features);
   } else {
     // Fallback (§3.4): mean Ê along the shared boundary, rescaled to [0,1] per image.
     strength.resize(pairs.pairs.size());

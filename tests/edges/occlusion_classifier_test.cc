@@ -388,6 +388,33 @@ TEST_F(TrainedOcclusionTest, ObjectContoursBeatRoadTexture) {
   EXPECT_LT(fallback_object - fallback_texture, object - texture);
 }
 
+// The forest walks the pairs in pieces on OpenCV's threads when there are enough of them: a grid
+// of 5 x 5 px superpixels (4 x 4 inside, 1 px boundaries) gives some 25 000 pairs, several pieces.
+TEST_F(TrainedOcclusionTest, PaintIsTheSameOnOneThreadAndOnSeveral) {
+  const SyntheticFrame test = MakeFrame(43);
+  cv::Mat3b image;
+  cv::resize(test.frame.image, image, cv::Size(640, 400));
+  cv::Mat1f edge;
+  cv::resize(test.frame.enhanced_edge, edge, image.size());
+  Superpixels grid;
+  grid.labels = cv::Mat1i(image.size(), 0);
+  const int cols = image.cols / 5;
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x)
+      if (x % 5 != 4 && y % 5 != 4) grid.labels(y, x) = 1 + (y / 5) * cols + x / 5;
+  grid.count = cols * (image.rows / 5);
+  const int threads_before = cv::getNumThreads();
+  cv::setNumThreads(1);
+  const cv::Mat1f one = Painted(*classifier_, image, edge, grid);
+  cv::setNumThreads(3);
+  const cv::Mat1f three = Painted(*classifier_, image, edge, grid);
+  cv::setNumThreads(threads_before);
+  ASSERT_EQ(one.size(), image.size());
+  ASSERT_EQ(three.size(), image.size());
+  EXPECT_EQ(cv::countNonZero(one != three), 0);
+  EXPECT_GT(cv::countNonZero(one > SmallForest().floor), 1000);  // the forest painted them
+}
+
 TEST_F(TrainedOcclusionTest, PaintOnlyOnBoundariesAndAtLeastFloor) {
   const SyntheticFrame test = MakeFrame(42);
   const OcclusionTrainingFrame& f = test.frame;
