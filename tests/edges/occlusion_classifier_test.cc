@@ -389,7 +389,7 @@ TEST_F(TrainedOcclusionTest, ObjectContoursBeatRoadTexture) {
 }
 
 // The forest walks the pairs in pieces on OpenCV's threads when there are enough of them: a grid
-// of 5 x 5 px superpixels (4 x 4 inside, 1 px boundaries) gives some 25 000 pairs, several pieces.
+// of 5 x 5 px superpixels (4 x 4 inside, 1 px boundaries) gives over 20 000 pairs, several pieces.
 TEST_F(TrainedOcclusionTest, PaintIsTheSameOnOneThreadAndOnSeveral) {
   const SyntheticFrame test = MakeFrame(43);
   cv::Mat3b image;
@@ -403,6 +403,8 @@ TEST_F(TrainedOcclusionTest, PaintIsTheSameOnOneThreadAndOnSeveral) {
     for (int x = 0; x < image.cols; ++x)
       if (x % 5 != 4 && y % 5 != 4) grid.labels(y, x) = 1 + (y / 5) * cols + x / 5;
   grid.count = cols * (image.rows / 5);
+  // Enough pairs for three pieces of the walk (2048 pairs at least each).
+  ASSERT_GT(ComputeSuperpixelPairs(image, edge, grid).pairs.size(), 20000u);
   const int threads_before = cv::getNumThreads();
   cv::setNumThreads(1);
   const cv::Mat1f one = Painted(*classifier_, image, edge, grid);
