@@ -16,8 +16,8 @@ double Ratio(std::int64_t numerator, std::int64_t denominator) {
 
 }  // namespace
 
-Status PixelHistogramAccumulator::AddChecked(const cv::Mat1f& probability,
-                                             const cv::Mat1b& positive, const cv::Mat1b& negative) {
+Status PixelHistogramAccumulator::Add(const cv::Mat1f& probability, const cv::Mat1b& positive,
+                                      const cv::Mat1b& negative) {
   if (positive.size() != probability.size() || negative.size() != probability.size()) {
     const auto dims = [](const cv::Mat& m) {
       return std::to_string(m.cols) + "x" + std::to_string(m.rows);
@@ -46,12 +46,6 @@ Status PixelHistogramAccumulator::AddChecked(const cv::Mat1f& probability,
     negative_total_ += negative_histogram_[v];
   }
   return Status::Ok();
-}
-
-void PixelHistogramAccumulator::Add(const cv::Mat1f& probability, const cv::Mat1b& positive,
-                                    const cv::Mat1b& negative) {
-  Status status = AddChecked(probability, positive, negative);
-  if (!status.ok() && first_error_.ok()) first_error_ = std::move(status);
 }
 
 std::vector<PixelHistogramAccumulator::OperatingPoint> PixelHistogramAccumulator::OperatingPoints()

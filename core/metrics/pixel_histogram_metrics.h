@@ -34,12 +34,9 @@ class PixelHistogramAccumulator {
 
   // probability: the float map in [0,1]; positive / negative masks: nonzero (255) = member,
   // pixels in neither (void / ignored) are not counted; a pixel in both counts in both, as in
-  // PixelRocAccumulator. O(pixels). A frame whose masks do not match the map in size is skipped
-  // and its error kept in status() (the first such error).
-  void Add(const cv::Mat1f& probability, const cv::Mat1b& positive, const cv::Mat1b& negative);
-  // As Add, but returns the error for a mismatched frame (which is then not counted).
-  Status AddChecked(const cv::Mat1f& probability, const cv::Mat1b& positive,
-                    const cv::Mat1b& negative);
+  // PixelRocAccumulator. O(pixels). A frame whose masks do not match the map in size is an error
+  // and is not counted.
+  Status Add(const cv::Mat1f& probability, const cv::Mat1b& positive, const cv::Mat1b& negative);
 
   // Step-wise average precision, sum over thresholds of (R_t - R_prev) * P_t (the definition of
   // sklearn's average_precision_score, no interpolation). NaN when there is no positive pixel.
@@ -53,8 +50,6 @@ class PixelHistogramAccumulator {
 
   std::int64_t positive_pixels() const { return positive_total_; }
   std::int64_t negative_pixels() const { return negative_total_; }
-  // Ok, or the first error met by Add.
-  const Status& status() const { return first_error_; }
 
  private:
   // Cumulative counts at one threshold level.
@@ -71,7 +66,6 @@ class PixelHistogramAccumulator {
   std::array<std::int64_t, kLevels> negative_histogram_{};
   std::int64_t positive_total_ = 0;
   std::int64_t negative_total_ = 0;
-  Status first_error_;
 };
 
 }  // namespace tod

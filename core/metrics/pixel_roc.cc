@@ -30,8 +30,8 @@ int PixelRocAccumulator::ThresholdsBelow(float p) const {
   return below;
 }
 
-Status PixelRocAccumulator::AddChecked(const cv::Mat1f& probability, const cv::Mat1b& obstacle,
-                                       const cv::Mat1b& road) {
+Status PixelRocAccumulator::Add(const cv::Mat1f& probability, const cv::Mat1b& obstacle,
+                                const cv::Mat1b& road) {
   if (obstacle.size() != probability.size() || road.size() != probability.size()) {
     const auto dims = [](const cv::Mat& m) {
       return std::to_string(m.cols) + "x" + std::to_string(m.rows);
@@ -66,12 +66,6 @@ Status PixelRocAccumulator::AddChecked(const cv::Mat1f& probability, const cv::M
   obstacle_total_ += tp + obstacle_hist[0];
   road_total_ += fp + road_hist[0];
   return Status::Ok();
-}
-
-void PixelRocAccumulator::Add(const cv::Mat1f& probability, const cv::Mat1b& obstacle,
-                              const cv::Mat1b& road) {
-  Status status = AddChecked(probability, obstacle, road);
-  if (!status.ok() && first_error_.ok()) first_error_ = std::move(status);
 }
 
 RocCurve PixelRocAccumulator::Curve() const {

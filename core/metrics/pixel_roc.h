@@ -22,19 +22,15 @@ class PixelRocAccumulator {
   // float probability is compared after exact promotion to double). num_thresholds >= 2.
   explicit PixelRocAccumulator(int num_thresholds = 201);
   // probability in [0,1]; obstacle / road masks: nonzero (255) = member (ignore = neither).
-  // O(pixels + thresholds). A frame whose masks do not match the probability map in size is
-  // skipped and its error kept in status() (the first such error).
-  void Add(const cv::Mat1f& probability, const cv::Mat1b& obstacle, const cv::Mat1b& road);
-  // As Add, but returns the error for a mismatched frame (which is then not counted).
-  Status AddChecked(const cv::Mat1f& probability, const cv::Mat1b& obstacle, const cv::Mat1b& road);
+  // O(pixels + thresholds). A frame whose masks do not match the probability map in size is an
+  // error and is not counted.
+  Status Add(const cv::Mat1f& probability, const cv::Mat1b& obstacle, const cv::Mat1b& road);
   RocCurve Curve() const;
   std::int64_t obstacle_pixels() const { return obstacle_total_; }
   std::int64_t road_pixels() const { return road_total_; }
   int num_thresholds() const { return num_thresholds_; }
   // The threshold with index i, exactly as used for counting.
   double Threshold(int i) const;
-  // Ok, or the first error met by Add.
-  const Status& status() const { return first_error_; }
 
  private:
   // Number of thresholds strictly below p, i.e. how many of the t_i satisfy p > t_i.
@@ -45,7 +41,6 @@ class PixelRocAccumulator {
   std::vector<std::int64_t> false_positives_;  // per threshold
   std::int64_t obstacle_total_ = 0;
   std::int64_t road_total_ = 0;
-  Status first_error_;
 };
 
 // TPR at a given FPR by linear interpolation of TPR over FPR along the curve sorted by FPR.

@@ -183,6 +183,22 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     std::vector<Box> gt;
     for (const auto& inst : s.instances) gt.push_back(inst.box);
     std::lock_guard lock(mutex);
+    // A map that does not match its frame's masks is this frame's error, not a silent gap in
+    // the pooled pixel counts. First, so that a failing frame is counted nowhere (every map has
+    // the frame's size, so the first variant decides).
+    const auto add_pixels = [&](const std::string& variant, const cv::Mat1f& map) {
+      if (Status st = roc.at(variant).Add(map, s.obstacle, s.road); !st.ok()) return st;
+      return served_map_histograms.at(variant).Add(map, s.obstacle, s.road);
+    };
+    for (const auto& [variant, map] :
+         {std::pair{"OP+ORDR@4", &map_op_ordr}, std::pair{"BP+ORDR@4", &map_bp_ordr},
+          std::pair{"BP+Fusion@4", &map_fusion}}) {
+      if (Status st = add_pixels(variant, *map); !st.ok()) return st.WithContext(variant);
+    }
+    if (calibrated_map) {
+      if (Status st = add_pixels(kCalibratedMapVariant, map_calibrated); !st.ok())
+        return st.WithContext(kCalibratedMapVariant);
+    }
     alarms.false_alarms += false_alarms;
     (s.free_space == FreeSpace::kRoadLabel ? road_labelled : not_obstacle) = true;
     alarms.instances_found += found;
@@ -198,16 +214,6 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     recall.at("OP+ORDR@4").Add(BoxesOf(RankedAboveThreshold(op_ordr, min_score)), gt);
     recall.at("BP+ORDR@4").Add(BoxesOf(RankedAboveThreshold(bp_ordr, min_score)), gt);
     recall.at("BP+Fusion@4").Add(BoxesOf(RankedAboveThreshold(bp_fusion, min_score)), gt);
-    roc.at("OP+ORDR@4").Add(map_op_ordr, s.obstacle, s.road);
-    roc.at("BP+ORDR@4").Add(map_bp_ordr, s.obstacle, s.road);
-    roc.at("BP+Fusion@4").Add(map_fusion, s.obstacle, s.road);
-    served_map_histograms.at("OP+ORDR@4").Add(map_op_ordr, s.obstacle, s.road);
-    served_map_histograms.at("BP+ORDR@4").Add(map_bp_ordr, s.obstacle, s.road);
-    served_map_histograms.at("BP+Fusion@4").Add(map_fusion, s.obstacle, s.road);
-    if (calibrated_map) {
-      roc.at(kCalibratedMapVariant).Add(map_calibrated, s.obstacle, s.road);
-      served_map_histograms.at(kCalibratedMapVariant).Add(map_calibrated, s.obstacle, s.road);
-    }
     for (const auto& [stage, ms] : timer.times()) {
       if (!stage_ms.count(stage)) stage_order.push_back(stage);
       stage_ms[stage].push_back(ms);

@@ -18,8 +18,7 @@ struct Frame {
 TEST(PixelRoc, HandComputedCurveWithValuesOnThresholds) {
   const Frame f;
   PixelRocAccumulator roc;
-  roc.Add(f.p, f.obstacle, f.road);
-  ASSERT_TRUE(roc.status().ok());
+  ASSERT_TRUE(roc.Add(f.p, f.obstacle, f.road).ok());
   EXPECT_EQ(roc.obstacle_pixels(), 2);
   EXPECT_EQ(roc.road_pixels(), 3);
   const RocCurve c = roc.Curve();
@@ -51,9 +50,10 @@ TEST(PixelRoc, CountsArePooledOverFramesNotAveraged) {
   PixelRocAccumulator roc;
   const cv::Mat1b none(1, 4, uchar{0});
   // Frame A: one obstacle pixel at P = 1. Frame B: three obstacle pixels at P = 0.
-  roc.Add((cv::Mat1f(1, 4) << 1, 0, 0, 0), (cv::Mat1b(1, 4) << 255, 0, 0, 0),
-          (cv::Mat1b(1, 4) << 0, 255, 255, 255));
-  roc.Add(cv::Mat1f(1, 4, 0.f), (cv::Mat1b(1, 4) << 0, 255, 255, 255), none);
+  ASSERT_TRUE(roc.Add((cv::Mat1f(1, 4) << 1, 0, 0, 0), (cv::Mat1b(1, 4) << 255, 0, 0, 0),
+                      (cv::Mat1b(1, 4) << 0, 255, 255, 255))
+                  .ok());
+  ASSERT_TRUE(roc.Add(cv::Mat1f(1, 4, 0.f), (cv::Mat1b(1, 4) << 0, 255, 255, 255), none).ok());
   const RocCurve c = roc.Curve();
   EXPECT_EQ(roc.obstacle_pixels(), 4);
   EXPECT_EQ(roc.road_pixels(), 3);
@@ -78,7 +78,7 @@ TEST(PixelRoc, HistogramMatchesBruteForceCount) {
     }
   }
   PixelRocAccumulator roc;
-  roc.Add(p, obstacle, road);
+  ASSERT_TRUE(roc.Add(p, obstacle, road).ok());
   const RocCurve c = roc.Curve();
   for (int i = 0; i < 201; ++i) {
     const double t = i / 200.0;
@@ -100,8 +100,9 @@ TEST(PixelRoc, HistogramMatchesBruteForceCount) {
 
 TEST(PixelRoc, OutOfRangeAndNanProbabilities) {
   PixelRocAccumulator roc(3);  // thresholds 0, 0.5, 1
-  roc.Add((cv::Mat1f(1, 3) << 1.5f, -0.2f, std::nanf("")), cv::Mat1b(1, 3, uchar{255}),
-          cv::Mat1b(1, 3, uchar{0}));
+  ASSERT_TRUE(roc.Add((cv::Mat1f(1, 3) << 1.5f, -0.2f, std::nanf("")), cv::Mat1b(1, 3, uchar{255}),
+                      cv::Mat1b(1, 3, uchar{0}))
+                  .ok());
   const RocCurve c = roc.Curve();
   ASSERT_EQ(c.thresholds, (std::vector<double>{0.0, 0.5, 1.0}));
   for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(c.tpr[i], 1.0 / 3.0);  // only 1.5 > every t
@@ -111,11 +112,11 @@ TEST(PixelRoc, OutOfRangeAndNanProbabilities) {
 TEST(PixelRoc, MismatchedFrameIsAnErrorAndNotCounted) {
   PixelRocAccumulator roc;
   const Status s =
-      roc.AddChecked(cv::Mat1f(2, 2, 0.5f), cv::Mat1b(2, 3, uchar{255}), cv::Mat1b(2, 2, uchar{0}));
+      roc.Add(cv::Mat1f(2, 2, 0.5f), cv::Mat1b(2, 3, uchar{255}), cv::Mat1b(2, 2, uchar{0}));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("obstacle mask is 3x2"), std::string::npos) << s.message();
-  roc.Add(cv::Mat1f(2, 2, 0.5f), cv::Mat1b(2, 2, uchar{255}), cv::Mat1b(1, 1, uchar{0}));
-  EXPECT_FALSE(roc.status().ok());
+  EXPECT_FALSE(
+      roc.Add(cv::Mat1f(2, 2, 0.5f), cv::Mat1b(2, 2, uchar{255}), cv::Mat1b(1, 1, uchar{0})).ok());
   EXPECT_EQ(roc.obstacle_pixels(), 0);
 }
 
@@ -142,7 +143,7 @@ TEST(TprAtFpr, DuplicateFprsTakeTheHighestTpr) {
 TEST(TprAtFpr, OnAccumulatedCurve) {
   const Frame f;
   PixelRocAccumulator roc;
-  roc.Add(f.p, f.obstacle, f.road);
+  ASSERT_TRUE(roc.Add(f.p, f.obstacle, f.road).ok());
   // FPR takes values 2/3, 1/3, 0; at FPR 0 the best TPR is 0.5 (t in [0.75, 1)), at 1/3 it is 1.
   const RocCurve c = roc.Curve();
   EXPECT_DOUBLE_EQ(TprAtFpr(c, 0.0), 0.5);
