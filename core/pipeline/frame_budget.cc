@@ -37,4 +37,23 @@ std::chrono::steady_clock::time_point ShareOfRemaining(
   return now + std::chrono::duration_cast<Clock::duration>((stage_deadline - now) * share);
 }
 
+std::vector<std::chrono::steady_clock::time_point> PlannedInTurn(
+    std::chrono::steady_clock::time_point stage_deadline, const std::vector<double>& weights) {
+  using Clock = std::chrono::steady_clock;
+  std::vector<Clock::time_point> deadlines(weights.size(), stage_deadline);
+  if (stage_deadline == Clock::time_point::max()) return deadlines;
+  const Clock::time_point now = Clock::now();
+  double total = 0;
+  for (const double w : weights) total += std::max(0.0, w);
+  if (now >= stage_deadline || !(total > 0)) return deadlines;
+  double before = 0;
+  for (std::size_t i = 0; i + 1 < weights.size(); ++i) {
+    before += std::max(0.0, weights[i]);
+    const double share = std::clamp(before / total, 0.0, 1.0);
+    deadlines[i] =
+        now + std::chrono::duration_cast<Clock::duration>((stage_deadline - now) * share);
+  }
+  return deadlines;  // the last piece ends with the stage
+}
+
 }  // namespace tod

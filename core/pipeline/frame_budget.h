@@ -4,13 +4,15 @@
 // degrade when their share runs out, in a defined way:
 //  - proposals: the window scan of each region stops handing out grid columns at the region's
 //    deadline (the columns left out are scattered over shapes and positions: a coarser grid);
-//    the far regions, scanned last, lose windows first;
+//    the far regions, scanned last, lose windows first (a request with several threads scans
+//    the regions side by side, each by the deadline it would have in turn: PlannedInTurn);
 //  - features and regression: proposals are regressed in objectness order, in chunks; those not
 //    reached by the deadline are left out of the map.
 // A frame that degrades says so (Detection::degraded_stages) and the server counts it.
 #pragma once
 
 #include <chrono>
+#include <vector>
 
 namespace tod {
 
@@ -50,5 +52,12 @@ double BudgetLeftMs(double budget_ms, double spent_ms);
 // piece i starts, so time a piece leaves unused passes on to the next ones.
 std::chrono::steady_clock::time_point ShareOfRemaining(
     std::chrono::steady_clock::time_point stage_deadline, double weight, double remaining_weight);
+
+// Deadlines for pieces of work planned in turn over [now, stage_deadline) but run at once: piece
+// i must end by now + (stage_deadline - now) * (weight_0 + ... + weight_i) / (sum of weights),
+// when it would end if the pieces ran one after another at a steady pace. Running them side by
+// side only lets a piece end sooner, so the last pieces are still the first to lose work.
+std::vector<std::chrono::steady_clock::time_point> PlannedInTurn(
+    std::chrono::steady_clock::time_point stage_deadline, const std::vector<double>& weights);
 
 }  // namespace tod

@@ -3,14 +3,18 @@
 #include <algorithm>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 
 #include "core/pipeline/frame_budget.h"
+#include "core/pipeline/parallel.h"
 #include "core/pipeline/pipeline_params.h"
 #include "core/proposals/greedy_nms.h"
 #include "core/proposals/window_grid.h"
 
 namespace tod {
+
+using Clock = std::chrono::steady_clock;
 
 Result<OcclusionEdges> ComputeOcclusionEdges(const cv::Mat3b& image,
                                              const MultilayerRegions& regions,
@@ -133,35 +137,84 @@ ProposalOptions DetectorProposalOptions(const PipelineParams& params, int layers
   return options;
 }
 
-ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
-                         const EdgeBoxParams& box_params, const ProposalOptions& options,
-                         const SizeFilter& size_filter) {
-  const int used = std::clamp(options.layers_used, 1, regions.num_layers());
-  // Each region's share of the time left is its share of the grid windows left (near to far).
+namespace {
+
+// Grid windows of each region the proposals use (0 for a region outside R1): the regions' shares
+// of the proposal stage's time.
+std::vector<double> RegionWindowCounts(const OcclusionEdges& oaocc,
+                                       const MultilayerRegions& regions,
+                                       const EdgeBoxParams& box_params, int used,
+                                       bool multistride) {
   std::vector<double> windows(used, 0.0);
   for (int k = 0; k < used; ++k) {
     const Box region = Intersect(regions.layers[k], oaocc.r1);
     if (region.empty()) continue;
-    windows[k] = static_cast<double>(
-        CountWindows(region.w, region.h,
-                     RegionBoxParams(box_params, k, regions.num_layers(), options.multistride)));
+    windows[k] = static_cast<double>(CountWindows(
+        region.w, region.h, RegionBoxParams(box_params, k, regions.num_layers(), multistride)));
   }
-  double windows_left = 0;
-  for (const double w : windows) windows_left += w;
-  std::vector<std::vector<ScoredBox>> per_region;
-  std::vector<int> truncated;
-  for (int k = 0; k < used; ++k) {
+  return windows;
+}
+
+// Region indexes, most windows first: the order in which concurrent workers pick regions up (the
+// windows are the cost known before the scan; the rest depends on the region's content).
+std::vector<int> LargestFirst(const std::vector<double>& windows) {
+  std::vector<int> order(windows.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return windows[a] > windows[b]; });
+  return order;
+}
+
+}  // namespace
+
+ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                         const EdgeBoxParams& box_params, const ProposalOptions& options,
+                         const SizeFilter& size_filter) {
+  const int used = std::clamp(options.layers_used, 1, regions.num_layers());
+  const std::vector<double> windows =
+      RegionWindowCounts(oaocc, regions, box_params, used, options.multistride);
+  const SizeFilter* filter = options.size_filter ? &size_filter : nullptr;
+  std::vector<std::vector<ScoredBox>> per_region(used);
+  std::vector<char> truncated(used, 0);
+  const auto propose = [&](int k, Clock::time_point deadline) {
     EdgeBoxParams params = box_params;
     params.threads = options.threads;
-    params.deadline = ShareOfRemaining(options.deadline, windows[k], windows_left);
-    windows_left -= windows[k];
+    params.deadline = deadline;
     EdgeBoxStats stats;
-    per_region.push_back(ProposeRegionBoxes(oaocc, regions, params, k, options.multistride,
-                                            options.size_filter ? &size_filter : nullptr, &stats));
-    if (stats.truncated) truncated.push_back(k);
+    per_region[k] =
+        ProposeRegionBoxes(oaocc, regions, params, k, options.multistride, filter, &stats);
+    truncated[k] = stats.truncated;
+  };
+  // Several threads: up to that many regions run side by side, each scanned with all of them.
+  // A region's own work (its edge groups, the selection of windows to refine, its NMS) is serial,
+  // so one region at a time left the other cores idle for a third of the stage; splitting the
+  // threads between the regions instead left them idle once the cheaper regions were done (a
+  // region's cost depends on its content, not only on its windows). The scheduler interleaves
+  // the threads; the boxes do not depend on it: each region's scan is the same whichever thread
+  // runs which of its chunks.
+  const int workers = std::min(std::max(1, options.threads), used);
+  if (workers > 1) {
+    const std::vector<Clock::time_point> deadlines = PlannedInTurn(options.deadline, windows);
+    const std::vector<int> order = LargestFirst(windows);
+    for (const Status& s : ParallelFor(used, workers, [&](int j) {
+           propose(order[j], deadlines[order[j]]);
+           return Status::Ok();
+         }))
+      if (!s.ok()) throw std::runtime_error(s.ToString());
+  } else {
+    // One thread: near to far, each region by its share of the time left when it starts.
+    double windows_left = 0;
+    for (const double w : windows) windows_left += w;
+    for (int k = 0; k < used; ++k) {
+      const Clock::time_point deadline =
+          ShareOfRemaining(options.deadline, windows[k], windows_left);
+      windows_left -= windows[k];
+      propose(k, deadline);
+    }
   }
   ProposalSet out = MergeRegionBoxes(per_region, options.merge_iou);
-  out.truncated_regions = std::move(truncated);
+  for (int k = 0; k < used; ++k)
+    if (truncated[k]) out.truncated_regions.push_back(k);
   return out;
 }
 

@@ -51,7 +51,10 @@ struct ProposalOptions {
   // Frame budget (frame_budget.h): the regions are scanned near to far, each until its share of
   // the time left to this deadline, by grid windows. No deadline: every window is scanned.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
-  int threads = 1;  // threads of each region's window scan (EdgeBoxParams::threads)
+  // Threads of the stage (0 = all cores, for one region at a time). Above 1, up to that many
+  // regions are scanned side by side, each with that many threads; the boxes are the same for
+  // every count.
+  int threads = 1;
 };
 
 // The detector's proposal options for a bundle's parameters: all `layers`, its multistride, size

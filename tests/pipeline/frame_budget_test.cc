@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <thread>
+#include <vector>
 
 #include "core/pipeline/obstacle_detector.h"
 #include "tests/pipeline/tiny_bundle.h"
@@ -44,6 +45,26 @@ TEST(FrameBudgetTest, ShareOfRemainingSplitsTheTimeLeftByWeight) {
   EXPECT_GE(quarter - before, std::chrono::minutes(15) - std::chrono::seconds(1));
   EXPECT_LE(quarter - before, std::chrono::minutes(15) + std::chrono::seconds(1));
   EXPECT_EQ(ShareOfRemaining(stage_end, 4, 4), stage_end);  // the last piece gets all the rest
+}
+
+TEST(FrameBudgetTest, PlannedInTurnEndsEachPieceWhenItsTurnWould) {
+  const std::vector<double> weights{1, 2, 1};
+  for (const Clock::time_point d : PlannedInTurn(Clock::time_point::max(), weights))
+    EXPECT_EQ(d, Clock::time_point::max());
+  const Clock::time_point past = Clock::now() - std::chrono::seconds(1);
+  for (const Clock::time_point d : PlannedInTurn(past, weights)) EXPECT_EQ(d, past);
+  const Clock::time_point before = Clock::now();
+  const Clock::time_point stage_end = before + std::chrono::hours(1);
+  const std::vector<Clock::time_point> planned = PlannedInTurn(stage_end, weights);
+  ASSERT_EQ(planned.size(), 3u);
+  // A quarter, three quarters and all of the hour from "now" (taken inside the call).
+  EXPECT_GE(planned[0] - before, std::chrono::minutes(15) - std::chrono::seconds(1));
+  EXPECT_LE(planned[0] - before, std::chrono::minutes(15) + std::chrono::seconds(1));
+  EXPECT_GE(planned[1] - before, std::chrono::minutes(45) - std::chrono::seconds(1));
+  EXPECT_LE(planned[1] - before, std::chrono::minutes(45) + std::chrono::seconds(1));
+  EXPECT_EQ(planned[2], stage_end);
+  // No weight at all: nothing to share by, every piece may use the whole stage.
+  for (const Clock::time_point d : PlannedInTurn(stage_end, {0, 0})) EXPECT_EQ(d, stage_end);
 }
 
 class DetectBudgetTest : public TinyDetectorTest {
