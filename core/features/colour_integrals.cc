@@ -1,5 +1,7 @@
 #include "core/features/colour_integrals.h"
 
+#include <opencv2/core/utility.hpp>
+
 #include <algorithm>
 
 namespace tod {
@@ -47,31 +49,38 @@ void ColourIntegrals::BuildPixels(const cv::Mat3b& bgr) {
   // Every entry is written below: no zero-filling of the (large) per-pixel tables.
   row_major_ = std::make_unique_for_overwrite<PixelCode[]>(pixels);
   column_major_ = std::make_unique_for_overwrite<PixelCode[]>(pixels);
-  PixelCode* code = row_major_.get();
-  for (int y = 0; y < height; ++y) {
-    const cv::Vec3b* row = bgr[y];
-    for (int x = 0; x < width; ++x, ++code) {
-      const PixelColour c = ClassifyPixel(row[x][0], row[x][1], row[x][2]);
-      code->bins = {c.hue_bin, static_cast<std::uint8_t>(kHueBins + c.sat_bin),
-                    static_cast<std::uint8_t>(kHueBins + kSatValBins + c.val_bin)};
-      code->max_level = c.max_level;
-      code->delta = c.delta;
-      code->unused = 0;
-      code->hue_units = c.hue_units;
+  // Rows (and tile rows of the transpose) are independent: they run on OpenCV's pool, as wide as
+  // the request's threads (cv::setNumThreads), with the same result for any width.
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const cv::Vec3b* row = bgr[y];
+      PixelCode* code = row_major_.get() + static_cast<std::size_t>(y) * width;
+      for (int x = 0; x < width; ++x, ++code) {
+        const PixelColour c = ClassifyPixel(row[x][0], row[x][1], row[x][2]);
+        code->bins = {c.hue_bin, static_cast<std::uint8_t>(kHueBins + c.sat_bin),
+                      static_cast<std::uint8_t>(kHueBins + kSatValBins + c.val_bin)};
+        code->max_level = c.max_level;
+        code->delta = c.delta;
+        code->unused = 0;
+        code->hue_units = c.hue_units;
+      }
     }
-  }
+  });
   // Transpose in tiles so that both sides stay in cache.
   constexpr int kTile = 32;
-  for (int ty = 0; ty < height; ty += kTile) {
-    for (int tx = 0; tx < width; tx += kTile) {
-      for (int x = tx; x < std::min(width, tx + kTile); ++x) {
-        for (int y = ty; y < std::min(height, ty + kTile); ++y) {
-          column_major_[static_cast<std::size_t>(x) * height + y] =
-              row_major_[static_cast<std::size_t>(y) * width + x];
+  const int tile_rows = (height + kTile - 1) / kTile;
+  cv::parallel_for_(cv::Range(0, tile_rows), [&](const cv::Range& bands) {
+    for (int ty = bands.start * kTile; ty < std::min(height, bands.end * kTile); ty += kTile) {
+      for (int tx = 0; tx < width; tx += kTile) {
+        for (int x = tx; x < std::min(width, tx + kTile); ++x) {
+          for (int y = ty; y < std::min(height, ty + kTile); ++y) {
+            column_major_[static_cast<std::size_t>(x) * height + y] =
+                row_major_[static_cast<std::size_t>(y) * width + x];
+          }
         }
       }
     }
-  }
+  });
 }
 
 void ColourIntegrals::BuildCorners() {
@@ -82,46 +91,52 @@ void ColourIntegrals::BuildCorners() {
   hist_corners_ = std::make_unique<std::uint16_t[]>(corners * kColourHistBins);
   moment_corners_ = std::make_unique<double[]>(corners * 6);
   if (cells_x <= 0) return;
-  // One band of cells at a time: per-cell sums, then prefix along x added to the row above.
-  std::vector<std::uint16_t> cell_hist(static_cast<std::size_t>(cells_x) * kColourHistBins);
-  std::vector<double> cell_moments(static_cast<std::size_t>(cells_x) * 6);
+  // Two passes over the corner tables. First every cell's own sums, written where its corner
+  // will be (bands are independent: OpenCV's pool runs them side by side); then, band by band,
+  // the prefix along x added to the row above, in place. The additions are the ones a single
+  // pass would make, in the same order, so the tables are the same.
   const int* cell_of_x = x_axis_.floor_line.data();  // x < width: index of its cell
-  for (int band = 0; band + 1 < lines_y; ++band) {
-    std::fill(cell_hist.begin(), cell_hist.end(), 0);
-    std::fill(cell_moments.begin(), cell_moments.end(), 0.0);
-    for (int y = y_axis_.lines[band]; y < y_axis_.lines[band + 1]; ++y) {
-      const PixelCode* code = row_major_.get() + static_cast<std::size_t>(y) * size_.width;
-      for (int x = 0; x < size_.width; ++x, ++code) {
-        const std::size_t cell = static_cast<std::size_t>(cell_of_x[x]);
-        std::uint16_t* hist = cell_hist.data() + cell * kColourHistBins;
-        ++hist[code->bins[0]];
-        ++hist[code->bins[1]];
-        ++hist[code->bins[2]];
-        const cv::Vec3f hsv = HsvFromLevels(code->max_level, code->delta, code->hue_units);
-        double* m = cell_moments.data() + cell * 6;
-        for (int c = 0; c < 3; ++c) {
-          m[c] += hsv[c];
-          m[3 + c] += static_cast<double>(hsv[c]) * hsv[c];
+  const auto hist_at = [&](int line_y, int line_x) {
+    return hist_corners_.get() +
+           (static_cast<std::size_t>(line_y) * lines_x + line_x) * kColourHistBins;
+  };
+  const auto moments_at = [&](int line_y, int line_x) {
+    return moment_corners_.get() + (static_cast<std::size_t>(line_y) * lines_x + line_x) * 6;
+  };
+  cv::parallel_for_(cv::Range(0, lines_y - 1), [&](const cv::Range& bands) {
+    for (int band = bands.start; band < bands.end; ++band) {
+      for (int y = y_axis_.lines[band]; y < y_axis_.lines[band + 1]; ++y) {
+        const PixelCode* code = row_major_.get() + static_cast<std::size_t>(y) * size_.width;
+        for (int x = 0; x < size_.width; ++x, ++code) {
+          const int cell = cell_of_x[x];
+          std::uint16_t* hist = hist_at(band + 1, cell + 1);
+          ++hist[code->bins[0]];
+          ++hist[code->bins[1]];
+          ++hist[code->bins[2]];
+          const cv::Vec3f hsv = HsvFromLevels(code->max_level, code->delta, code->hue_units);
+          double* m = moments_at(band + 1, cell + 1);
+          for (int c = 0; c < 3; ++c) {
+            m[c] += hsv[c];
+            m[3 + c] += static_cast<double>(hsv[c]) * hsv[c];
+          }
         }
       }
     }
+  });
+  for (int band = 0; band + 1 < lines_y; ++band) {
     std::array<std::uint16_t, kColourHistBins> running_hist{};
     std::array<double, 6> running_moments{};
     for (int cell = 0; cell < cells_x; ++cell) {
-      const std::uint16_t* above = HistCorner(band, cell + 1);
-      std::uint16_t* here =
-          hist_corners_.get() +
-          (static_cast<std::size_t>(band + 1) * lines_x + cell + 1) * kColourHistBins;
+      const std::uint16_t* above = hist_at(band, cell + 1);
+      std::uint16_t* here = hist_at(band + 1, cell + 1);  // holds the cell's own counts
       for (int bin = 0; bin < kColourHistBins; ++bin) {
-        running_hist[bin] =
-            static_cast<std::uint16_t>(running_hist[bin] + cell_hist[cell * kColourHistBins + bin]);
+        running_hist[bin] = static_cast<std::uint16_t>(running_hist[bin] + here[bin]);
         here[bin] = static_cast<std::uint16_t>(above[bin] + running_hist[bin]);  // mod 65536
       }
-      const double* above_m = MomentCorner(band, cell + 1);
-      double* here_m =
-          moment_corners_.get() + (static_cast<std::size_t>(band + 1) * lines_x + cell + 1) * 6;
+      const double* above_m = moments_at(band, cell + 1);
+      double* here_m = moments_at(band + 1, cell + 1);
       for (int k = 0; k < 6; ++k) {
-        running_moments[k] += cell_moments[cell * 6 + k];
+        running_moments[k] += here_m[k];
         here_m[k] = above_m[k] + running_moments[k];
       }
     }

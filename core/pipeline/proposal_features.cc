@@ -2,26 +2,32 @@
 
 #include "core/features/colour_integrals.h"
 #include "core/pipeline/frame_stages.h"
+#include "core/pipeline/parallel.h"
+
+#include <stdexcept>
 
 namespace tod {
 
 ProposalFeatureComputer::ProposalFeatureComputer(const cv::Mat3b& image,
                                                  const OcclusionEdges& oaocc,
                                                  const MultilayerRegions& regions,
-                                                 const ProposalSet& proposals)
+                                                 const ProposalSet& proposals, int threads)
     : proposals_(proposals), per_region_(regions.num_layers()) {
   if (proposals.boxes.empty()) return;
   std::vector<bool> used(regions.num_layers(), false);
   for (const int k : proposals.layer) used[k] = true;
   const auto frame_colour = std::make_shared<const ColourIntegrals>(
       image(oaocc.r1.rect()), cv::Point(oaocc.r1.x, oaocc.r1.y));
-  for (int k = 0; k < regions.num_layers(); ++k) {
-    if (!used[k]) continue;
-    const Box region = Intersect(regions.layers[k], oaocc.r1);
-    per_region_[k] =
-        std::make_unique<const BoxFeatureExtractor>(frame_colour, RegionEdgeMap(oaocc, regions, k),
-                                                    cv::Point(region.x, region.y), image.size());
-  }
+  // Each region's edge tables are one pass over its map, independent of the others.
+  for (const Status& s : ParallelFor(regions.num_layers(), threads, [&](int k) {
+         if (!used[k]) return Status::Ok();
+         const Box region = Intersect(regions.layers[k], oaocc.r1);
+         per_region_[k] = std::make_unique<const BoxFeatureExtractor>(
+             frame_colour, RegionEdgeMap(oaocc, regions, k), cv::Point(region.x, region.y),
+             image.size());
+         return Status::Ok();
+       }))
+    if (!s.ok()) throw std::runtime_error(s.ToString());
 }
 
 void ProposalFeatureComputer::ComputeRange(std::size_t begin, std::size_t end,

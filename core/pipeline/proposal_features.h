@@ -21,9 +21,12 @@ struct ProposalSet;
 // const and thread-safe).
 class ProposalFeatureComputer {
  public:
-  // Keeps references to all three arguments: they must outlive the computer.
+  // Keeps references to all three arguments: they must outlive the computer. The tables are
+  // built on up to `threads` threads (the regions' edge tables side by side; the colour tables
+  // on OpenCV's pool, cv::setNumThreads), the same for any count.
   ProposalFeatureComputer(const cv::Mat3b& image, const OcclusionEdges& oaocc,
-                          const MultilayerRegions& regions, const ProposalSet& proposals);
+                          const MultilayerRegions& regions, const ProposalSet& proposals,
+                          int threads = 1);
   // Rows [begin, end) of `out` (proposals x kNumBoxFeatures) for proposals [begin, end).
   void ComputeRange(std::size_t begin, std::size_t end, cv::Mat1f& out) const;
 

@@ -43,7 +43,7 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   const std::size_t n = proposals.boxes.size();
   cv::Mat1f features(static_cast<int>(n), kNumBoxFeatures, 0.f);
   out.ordr.assign(n, 0.f);
-  const ProposalFeatureComputer computer(image, oaocc, regions, proposals);
+  const ProposalFeatureComputer computer(image, oaocc, regions, proposals, limits.threads);
   std::size_t done = 0;
   Clock::duration feature_time{};
   while (done < n) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -426,6 +428,25 @@ TEST(ColourIntegralsTest, HistogramAndMomentsMatchBruteForce) {
     for (int k = 0; k < 6; ++k) ASSERT_NEAR(moments[k], expected[k], 1e-4) << "trial " << trial;
   }
   EXPECT_EQ(integrals.Histogram({0, 0, 0, 5}), ColourHistogram{});
+}
+
+// The pixel codes, the transpose and the cells' sums run on OpenCV's pool: one thread and four
+// must give the same tables, bit for bit (each band's sums are added in the same order).
+TEST(ColourIntegralsTest, OneThreadAndSeveralBuildTheSameTables) {
+  const cv::Mat3b image = RandomColours(301, 419, 7);
+  const int threads_before = cv::getNumThreads();
+  cv::setNumThreads(1);
+  const ColourIntegrals one(image, {3, 5});
+  cv::setNumThreads(4);
+  const ColourIntegrals four(image, {3, 5});
+  cv::setNumThreads(threads_before);
+  cv::RNG rng(11);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int w = rng.uniform(1, 420), h = rng.uniform(1, 302);
+    const cv::Rect r(rng.uniform(0, 420 - w), rng.uniform(0, 302 - h), w, h);
+    ASSERT_EQ(one.Histogram(r), four.Histogram(r)) << "trial " << trial;
+    ASSERT_EQ(one.Moments(r), four.Moments(r)) << "trial " << trial;
+  }
 }
 
 TEST(ColourIntegralsTest, CountsAbove65535AreExact) {
