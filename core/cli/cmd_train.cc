@@ -63,6 +63,10 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--occlusion-trees", args->train.occlusion_params.forest.num_trees,
                   "trees of the occlusion classifier")
       ->check(CLI::Range(1, 2000));
+  cmd->add_option("--superpixel-strips", args->train.params.superpixels.strip_rows,
+                  "sweep the sticky superpixels in strips of N rows, side by side on a "
+                  "request's threads (0 = raster order, one thread: the default)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", args->train.threads, "worker threads (0 = all cores)");
   cmd->add_option("--on-bad-frame", args->on_bad_frame,
                   "fail: stop at an unreadable frame; skip: leave it out, list and count it")

@@ -56,6 +56,9 @@ Status ValidateSuperpixelInput(const cv::Mat3b& bgr, const cv::Mat1f& edge,
   if (params.iterations < 0) {
     return Status::InvalidArgument("sticky superpixels: params.iterations must be >= 0");
   }
+  if (params.strip_rows < 0) {
+    return Status::InvalidArgument("sticky superpixels: params.strip_rows must be >= 0");
+  }
   return Status::Ok();
 }
 
@@ -87,7 +90,7 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
     half_weights.position *= 4.0;
     std::vector<int> half_labels = OneLabelPerPixel(half_w, half_h);
     RefineStickyLabels(ViewOf(smooth_half, edge_half), half_weights, 2 * params.iterations,
-                       half_labels);
+                       half_labels, params.strip_rows / 2);
     // Nearest ×2 upsampling; odd last row/column replicate their neighbour.
     flat.resize(static_cast<size_t>(width) * height);
     for (int y = 0; y < height; ++y) {
@@ -103,7 +106,8 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
   }
 
   const cv::Mat3f smooth_full = SmoothColour(colour);
-  RefineStickyLabels(ViewOf(smooth_full, edge_full), weights, params.iterations, flat);
+  RefineStickyLabels(ViewOf(smooth_full, edge_full), weights, params.iterations, flat,
+                     params.strip_rows);
 
   Superpixels result;
   result.labels = cv::Mat1i(height, width);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <opencv2/core/utility.hpp>
 #include <utility>
 #include <vector>
 
@@ -73,15 +74,226 @@ StickyWeights StickyWeightsFor(int k, double alpha, double beta) {
   return w;
 }
 
+namespace {
+
+// Rows [first, last] a label's pixels lay in at some point of the current sweep (a superset of
+// where they lie now: a pixel leaving a label does not shrink it).
+struct RowExtent {
+  int first = std::numeric_limits<int>::max();
+  int last = -1;
+  void Add(int row) {
+    first = std::min(first, row);
+    last = std::max(last, row);
+  }
+};
+
+// The state one refinement works on and the move of one pixel (ALGORITHM.md §3.2(1)).
+class StickyRefiner {
+ public:
+  StickyRefiner(const StickyImage& image, const StickyWeights& weights, std::vector<int>& labels)
+      : image_(image), weights_(weights), labels_(labels) {}
+
+  std::vector<int>& labels() { return labels_; }
+  std::vector<LabelSums>& sums() { return sums_; }
+  std::vector<RowExtent>& extents() { return extents_; }
+
+  // Whether pixel i has a 4-neighbour of another label (only such pixels can move), decided from
+  // the labels alone, before any edge value is loaded.
+  bool OnBorder(int x, int y) const {
+    const size_t i = static_cast<size_t>(y) * image_.width + x;
+    const int own = labels_[i];
+    return (x > 0 && labels_[i - 1] != own) || (y > 0 && labels_[i - image_.width] != own) ||
+           (x + 1 < image_.width && labels_[i + 1] != own) ||
+           (y + 1 < image_.height && labels_[i + image_.width] != own);
+  }
+
+  // Whether the move of pixel (x, y) would read or write the sums of a label `blocked` marks.
+  bool Touches(int x, int y, const std::vector<char>& blocked) const {
+    const size_t i = static_cast<size_t>(y) * image_.width + x;
+    return blocked[labels_[i]] || (x > 0 && blocked[labels_[i - 1]]) ||
+           (y > 0 && blocked[labels_[i - image_.width]]) ||
+           (x + 1 < image_.width && blocked[labels_[i + 1]]) ||
+           (y + 1 < image_.height && blocked[labels_[i + image_.width]]);
+  }
+
+  // Moves the border pixel (x, y) to the neighbouring label of least cost (ties go to its own
+  // label, then to the earliest neighbour in the order left, up, right, down); true if it moved.
+  bool Move(int x, int y) {
+    const int width = image_.width;
+    const size_t i = static_cast<size_t>(y) * width + x;
+    const int own = labels_[i];
+    std::array<int, 4> nb_label;
+    std::array<float, 4> nb_edge;
+    int nb_count = 0;
+    auto push = [&](size_t j) {
+      nb_label[nb_count] = labels_[j];
+      nb_edge[nb_count] = image_.edge[j];
+      ++nb_count;
+    };
+    if (x > 0) push(i - 1);
+    if (y > 0) push(i - width);
+    if (x + 1 < width) push(i + 1);
+    if (y + 1 < image_.height) push(i + width);
+
+    const float* c = image_.colour + 3 * i;
+    const double px = x;
+    const double py = y;
+    auto cost = [&](int t) {
+      const LabelSums& s = sums_[t];
+      // Size counted as if the pixel belonged to t (it already does when t is its own label):
+      // with every pixel its own label initially this is what lets singletons merge.
+      const double n = s.count + (t == own ? 0.0 : 1.0);
+      const double inv = s.inverse_count;
+      const double dx = px - s.x * inv;
+      const double dy = py - s.y * inv;
+      const double d0 = c[0] - s.c0 * inv;
+      const double d1 = c[1] - s.c1 * inv;
+      const double d2 = c[2] - s.c2 * inv;
+      // e_t: weakest edge among the neighbours that would be across a boundary from the pixel if
+      // it took label t; no such neighbour means no boundary at all, rewarded as the strongest
+      // neighbouring edge.
+      float e_min = std::numeric_limits<float>::max();
+      float e_max = 0.f;
+      for (int k = 0; k < nb_count; ++k) {
+        e_max = std::max(e_max, nb_edge[k]);
+        if (nb_label[k] != t) e_min = std::min(e_min, nb_edge[k]);
+      }
+      const double e_t = e_min == std::numeric_limits<float>::max() ? e_max : e_min;
+      return weights_.position * (dx * dx + dy * dy) +
+             weights_.colour * (d0 * d0 + d1 * d1 + d2 * d2) - weights_.edge * e_t +
+             weights_.size / n;
+    };
+
+    int best = own;
+    double best_cost = cost(own);
+    for (int k = 0; k < nb_count; ++k) {
+      const int t = nb_label[k];
+      if (t == own || t == best) continue;
+      bool seen = false;
+      for (int m = 0; m < k; ++m) seen |= nb_label[m] == t;
+      if (seen) continue;
+      const double ct = cost(t);
+      if (ct < best_cost) {
+        best_cost = ct;
+        best = t;
+      }
+    }
+    if (best == own) return false;
+    sums_[own].Add(-1.0, x, y, c);
+    sums_[best].Add(1.0, x, y, c);
+    if (!extents_.empty()) extents_[best].Add(y);
+    labels_[i] = best;
+    return true;
+  }
+
+  // Rows [y_begin, y_end) in raster order; returns the pixels moved. With `shared`, the pixels
+  // whose move would touch a label it marks are not moved but appended to `deferred`.
+  long long SweepRows(int y_begin, int y_end, const std::vector<char>* shared,
+                      std::vector<int>* deferred) {
+    long long moved = 0;
+    for (int y = y_begin; y < y_end; ++y)
+      for (int x = 0; x < image_.width; ++x) {
+        if (!OnBorder(x, y)) continue;
+        if (shared != nullptr && Touches(x, y, *shared))
+          deferred->push_back(y * image_.width + x);
+        else
+          moved += Move(x, y);
+      }
+    return moved;
+  }
+
+  // One sweep in raster order (the reference order); returns the pixels moved.
+  long long SweepRaster() { return SweepRows(0, image_.height, nullptr, nullptr); }
+
+  // One sweep in strips of strip_rows rows, the first one `shift` rows short: the even strips side
+  // by side, then the odd ones, each in raster order (see RefineStickyLabels). Needs the extents
+  // (ResetExtents), and keeps them.
+  long long SweepStrips(int strip_rows, int shift);
+
+  // Every label's rows as they are now; the moves then only grow them.
+  void ResetExtents() {
+    extents_.assign(sums_.size(), RowExtent{});
+    for (int y = 0; y < image_.height; ++y)
+      for (int x = 0; x < image_.width; ++x)
+        extents_[labels_[static_cast<size_t>(y) * image_.width + x]].Add(y);
+  }
+
+ private:
+  // Labels whose sums strips of `parity` other than their own may touch: a label's pixels and
+  // their 4-neighbours lie within its extent grown by a row, and a strip's moves touch only the
+  // labels of its rows and of the row on either side (which belong to strips of the other parity,
+  // still during this half-sweep).
+  std::vector<char> SharedLabels(int strip_rows, int shift, int parity) const;
+
+  const StickyImage& image_;
+  const StickyWeights& weights_;
+  std::vector<int>& labels_;
+  std::vector<LabelSums> sums_;
+  std::vector<RowExtent> extents_;  // per label, kept by SweepStrips
+};
+
+std::vector<char> StickyRefiner::SharedLabels(int strip_rows, int shift, int parity) const {
+  std::vector<char> shared(sums_.size(), 0);
+  for (size_t label = 0; label < extents_.size(); ++label) {
+    const RowExtent& e = extents_[label];
+    if (e.last < 0) continue;
+    // In rows counted from `shift` rows above the first, strip s touches rows [s·n − 1, (s+1)·n]:
+    // it meets [first, last] for ceil(first / n) − 1 <= s <= (last + 1) / n.
+    const int first = e.first + shift, last = e.last + shift;
+    int first_strip = std::max(0, (first + strip_rows - 1) / strip_rows - 1);
+    int last_strip = (last + 1) / strip_rows;
+    if ((first_strip & 1) != parity) ++first_strip;
+    if ((last_strip & 1) != parity) --last_strip;
+    shared[label] = last_strip > first_strip;
+  }
+  return shared;
+}
+
+long long StickyRefiner::SweepStrips(int strip_rows, int shift) {
+  const int height = image_.height, width = image_.width;
+  const int strips = (height + shift + strip_rows - 1) / strip_rows;
+  long long moved = 0;
+  for (int parity = 0; parity < 2; ++parity) {
+    const std::vector<char> shared = SharedLabels(strip_rows, shift, parity);
+    // Usually no label reaches over a whole strip: then no pixel needs the check.
+    const bool any_shared = std::find(shared.begin(), shared.end(), 1) != shared.end();
+    const int count = (strips - parity + 1) / 2;  // strips parity, parity + 2, ...
+    std::vector<long long> moved_in(count, 0);
+    std::vector<std::vector<int>> deferred(count);  // pixel indices, raster order per strip
+    // The strips of one parity share no label they may move (SharedLabels): their moves touch
+    // disjoint sums, and they can run side by side, on OpenCV's pool.
+    cv::parallel_for_(cv::Range(0, count), [&](const cv::Range& range) {
+      for (int j = range.start; j < range.end; ++j) {
+        const int strip = parity + 2 * j;
+        moved_in[j] = SweepRows(std::max(0, strip * strip_rows - shift),
+                                std::min(height, (strip + 1) * strip_rows - shift),
+                                any_shared ? &shared : nullptr, &deferred[j]);
+      }
+    });
+    // Pixels next to a label several strips may touch: after the strips, in raster order.
+    for (int j = 0; j < count; ++j) {
+      moved += moved_in[j];
+      for (const int i : deferred[j]) {
+        const int x = i % width, y = i / width;
+        if (OnBorder(x, y)) moved += Move(x, y);
+      }
+    }
+  }
+  return moved;
+}
+
+}  // namespace
+
 int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, int iterations,
-                       std::vector<int>& labels) {
+                       std::vector<int>& labels, int strip_rows) {
   const int width = image.width;
   const int height = image.height;
   if (width <= 0 || height <= 0 || labels.empty()) return 0;
+  StickyRefiner refiner(image, weights, labels);
+  std::vector<LabelSums>& sums = refiner.sums();
   const int max_label = *std::max_element(labels.begin(), labels.end());
   std::vector<int> original_id(static_cast<size_t>(max_label) + 1);
   for (size_t id = 0; id < original_id.size(); ++id) original_id[id] = static_cast<int>(id);
-  std::vector<LabelSums> sums;
   RenumberDensely(labels, sums, original_id);
   sums.resize(original_id.size());
   for (int y = 0; y < height; ++y) {
@@ -91,92 +303,29 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
     }
   }
 
+  // Strips only pay off when there are several of them.
+  const bool in_strips = strip_rows > 0 && height > 2 * strip_rows;
+  if (in_strips) refiner.ResetExtents();
   int sweeps = 0;
   for (int iter = 0; iter < iterations; ++iter) {
     ++sweeps;
-    long long moved = 0;
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        const size_t i = static_cast<size_t>(y) * width + x;
-        const int own = labels[i];
-        // Interior pixels (every 4-neighbour shares the label) cannot move: decided from the
-        // labels alone, before any edge value is loaded.
-        const bool on_border =
-            (x > 0 && labels[i - 1] != own) || (y > 0 && labels[i - width] != own) ||
-            (x + 1 < width && labels[i + 1] != own) || (y + 1 < height && labels[i + width] != own);
-        if (!on_border) continue;
-        // 4-neighbours in the order left, up, right, down (ties go to the earliest candidate).
-        std::array<int, 4> nb_label;
-        std::array<float, 4> nb_edge;
-        int nb_count = 0;
-        auto push = [&](size_t j) {
-          nb_label[nb_count] = labels[j];
-          nb_edge[nb_count] = image.edge[j];
-          ++nb_count;
-        };
-        if (x > 0) push(i - 1);
-        if (y > 0) push(i - width);
-        if (x + 1 < width) push(i + 1);
-        if (y + 1 < height) push(i + width);
-
-        const float* c = image.colour + 3 * i;
-        const double px = x;
-        const double py = y;
-        auto cost = [&](int t) {
-          const LabelSums& s = sums[t];
-          // Size counted as if the pixel belonged to t (it already does when t is its own label):
-          // with every pixel its own label initially this is what lets singletons merge.
-          const double n = s.count + (t == own ? 0.0 : 1.0);
-          const double inv = s.inverse_count;
-          const double dx = px - s.x * inv;
-          const double dy = py - s.y * inv;
-          const double d0 = c[0] - s.c0 * inv;
-          const double d1 = c[1] - s.c1 * inv;
-          const double d2 = c[2] - s.c2 * inv;
-          // e_t: weakest edge among the neighbours that would be across a boundary from the
-          // pixel if it took label t; no such neighbour means no boundary at all, rewarded as
-          // the strongest neighbouring edge.
-          float e_min = std::numeric_limits<float>::max();
-          float e_max = 0.f;
-          for (int k = 0; k < nb_count; ++k) {
-            e_max = std::max(e_max, nb_edge[k]);
-            if (nb_label[k] != t) e_min = std::min(e_min, nb_edge[k]);
-          }
-          const double e_t = e_min == std::numeric_limits<float>::max() ? e_max : e_min;
-          return weights.position * (dx * dx + dy * dy) +
-                 weights.colour * (d0 * d0 + d1 * d1 + d2 * d2) - weights.edge * e_t +
-                 weights.size / n;
-        };
-
-        int best = own;
-        double best_cost = cost(own);
-        for (int k = 0; k < nb_count; ++k) {
-          const int t = nb_label[k];
-          if (t == own || t == best) continue;
-          bool seen = false;
-          for (int m = 0; m < k; ++m) seen |= nb_label[m] == t;
-          if (seen) continue;
-          const double ct = cost(t);
-          if (ct < best_cost) {
-            best_cost = ct;
-            best = t;
-          }
-        }
-        if (best != own) {
-          sums[own].Add(-1.0, x, y, c);
-          sums[best].Add(1.0, x, y, c);
-          labels[i] = best;
-          ++moved;
-        }
-      }
-    }
+    // The first sweep runs in raster order: from one label per pixel, strips started afresh at
+    // every strip border and left 5-10 % more boundary pixels on the border rows (and 2-5 % more
+    // superpixels on real frames). Later sweeps shift the strips by half a strip every other time,
+    // so that no row is always a border where the order changes.
+    const long long moved = in_strips && iter > 0
+                                ? refiner.SweepStrips(strip_rows, (iter % 2) * (strip_rows / 2))
+                                : refiner.SweepRaster();
     if (moved == 0) break;
     if (iter + 1 < iterations) {
       // Compact once at least half of the labels have emptied (a pass over the labels, cheap
       // next to a sweep).
       const auto alive =
           std::count_if(sums.begin(), sums.end(), [](const LabelSums& s) { return s.count > 0; });
-      if (2 * static_cast<size_t>(alive) <= sums.size()) RenumberDensely(labels, sums, original_id);
+      if (2 * static_cast<size_t>(alive) <= sums.size()) {
+        RenumberDensely(labels, sums, original_id);
+        if (in_strips) refiner.ResetExtents();  // indexed by the new ids, and tight again
+      }
     }
   }
   for (int& label : labels) label = original_id[label];

@@ -1,8 +1,7 @@
 #include "core/features/colour_integrals.h"
 
-#include <opencv2/core/utility.hpp>
-
 #include <algorithm>
+#include <opencv2/core/utility.hpp>
 
 namespace tod {
 namespace {

@@ -13,7 +13,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegionParams, num_layers, restar
                                                 margin_fraction, seed)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GradientEdgeParams, smooth_radius,
                                                 normalise_percentile)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StickySuperpixelParams, k, alpha, beta, iterations)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StickySuperpixelParams, k, alpha, beta, iterations,
+                                                strip_rows)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeBoxParams, alpha, beta, min_score, max_boxes,
                                                 edge_min_mag, edge_merge_thr, cluster_min_mag,
                                                 max_aspect_ratio, min_box_area, gamma, kappa,

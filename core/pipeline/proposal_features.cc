@@ -1,10 +1,10 @@
 #include "core/pipeline/proposal_features.h"
 
+#include <stdexcept>
+
 #include "core/features/colour_integrals.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/parallel.h"
-
-#include <stdexcept>
 
 namespace tod {
 

@@ -155,14 +155,15 @@ TEST_F(MasksCliTest, HardNegativeMiningByDefaultOneRoundOnRequest) {
   EXPECT_TRUE(m["training"]["seconds"].contains("hard_negatives"));
 }
 
-// The classifiers' tree counts are choices the manifest records; out of range is refused before
-// any work.
+// The classifiers' tree counts and the superpixels' sweep order are choices the manifest
+// records; out of range is refused before any work.
 TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   const std::string model = (out_ / "trees").string();
-  const CommandResult run =
-      RunCommand(Train(model, "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2"));
+  const CommandResult run = RunCommand(Train(
+      model, "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2 --superpixel-strips 16"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json manifest = Manifest(model);
+  EXPECT_EQ(manifest["params"]["superpixels"]["strip_rows"], 16);
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 4);
   EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 12);
   // The regressors' negatives per frame and range: twice the paper's 17 (ORDR) and 25 (OBDR).
@@ -170,7 +171,7 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
             nlohmann::json({34, 34, 34, 34}));
   EXPECT_EQ(manifest["training"]["parts"]["obdr"]["negatives_per_range"],
             nlohmann::json({50, 50, 50, 50}));
-  for (const char* flag : {"--edge-trees 0", "--negatives-scale 0"}) {
+  for (const char* flag : {"--edge-trees 0", "--negatives-scale 0", "--superpixel-strips -1"}) {
     const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), flag));
     EXPECT_NE(wrong.exit_code, 0) << flag;
     EXPECT_NE(wrong.output.find(std::string(flag).substr(0, std::string(flag).find(' '))),

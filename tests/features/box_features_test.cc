@@ -2,12 +2,11 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/core/utility.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
