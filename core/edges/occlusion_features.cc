@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <opencv2/core/hal/hal.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace tod {
@@ -173,15 +174,14 @@ float ChiSquaredDistance(const float* p, const float* q, int bins) {
   return 0.5f * sum;
 }
 
-SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                                       const Superpixels& superpixels) {
+namespace {
+
+// Step 1: the boundary pixels, the pairs each borders (CSR, in `out`) and their coordinates.
+std::vector<cv::Point> ScanBoundaries(const Superpixels& superpixels, SuperpixelPairs& out) {
   const cv::Mat1i& labels = superpixels.labels;
   const int width = labels.cols;
   const int height = labels.rows;
-  SuperpixelPairs out;
   out.pixel_offsets.push_back(0);
-
-  // Boundary pixels and the pairs each borders.
   std::vector<std::vector<cv::Vec2i>> adjacency(static_cast<size_t>(superpixels.count) + 1);
   // Consecutive boundary pixels nearly always border the same pair: a one-entry cache in front
   // of PairIndex skips the adjacency scan. PairIndex returns the same index for a pair every
@@ -195,8 +195,8 @@ SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& 
     }
     return cached_index;
   };
-  // Coordinates of every boundary pixel, so that the per-pair loops below need no division of
-  // the flat index.
+  // Coordinates of every boundary pixel, so that the per-pair loops need no division of the flat
+  // index.
   std::vector<cv::Point> boundary_points;
   for (int y = 0; y < height; ++y) {
     const int* row = labels[y];
@@ -250,88 +250,131 @@ SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& 
       out.pixel_offsets.push_back(static_cast<int>(out.pixel_pairs.size()));
     }
   }
+  return boundary_points;
+}
 
-  // Invert to per-pair pixel lists (counting sort by pair).
+// Step 2: every pair's boundary pixels, in boundary order (a counting sort by pair).
+struct PairPixels {
+  std::vector<int> offsets;  // pair p: points[offsets[p] .. offsets[p + 1])
+  std::vector<cv::Point> points;
+};
+
+PairPixels InvertToPairs(const SuperpixelPairs& pairs,
+                         const std::vector<cv::Point>& boundary_points) {
+  const int num_pairs = static_cast<int>(pairs.pairs.size());
+  PairPixels out;
+  out.offsets.assign(static_cast<size_t>(num_pairs) + 1, 0);
+  for (int p : pairs.pixel_pairs) ++out.offsets[p + 1];
+  for (int p = 0; p < num_pairs; ++p) out.offsets[p + 1] += out.offsets[p];
+  out.points.resize(pairs.pixel_pairs.size());
+  std::vector<int> cursor(out.offsets.begin(), out.offsets.end() - 1);
+  for (size_t i = 0; i < boundary_points.size(); ++i) {
+    for (int k = pairs.pixel_offsets[i]; k < pairs.pixel_offsets[i + 1]; ++k) {
+      out.points[cursor[pairs.pixel_pairs[k]]++] = boundary_points[i];
+    }
+  }
+  return out;
+}
+
+// Step 3: the features of pair p (row f) from its boundary pixels and its two regions' stats.
+// `values` is scratch.
+void PairFeatures(const cv::Mat1f& enhanced_edge, const PairPixels& pixels,
+                  const std::vector<RegionStats>& regions, const cv::Vec2i& pair, int p,
+                  float inv_height, std::vector<float>& values, float* f) {
+  const int begin = pixels.offsets[p];
+  const int end = pixels.offsets[p + 1];
+  const int length = end - begin;
+  values.clear();
+  double sum_x = 0.0;
+  double sum_y = 0.0;
+  for (int k = begin; k < end; ++k) {
+    const cv::Point pixel = pixels.points[k];
+    values.push_back(enhanced_edge(pixel.y, pixel.x));
+    sum_x += pixel.x;
+    sum_y += pixel.y;
+  }
+  const double mean_x = sum_x / length;
+  const double mean_y = sum_y / length;
+  double sxx = 0.0;
+  double syy = 0.0;
+  double sxy = 0.0;
+  for (int k = begin; k < end; ++k) {
+    const double dx = pixels.points[k].x - mean_x;
+    const double dy = pixels.points[k].y - mean_y;
+    sxx += dx * dx;
+    syy += dy * dy;
+    sxy += dx * dy;
+  }
+  float edge_sum = 0.f;
+  float edge_max = 0.f;
+  for (float v : values) {
+    edge_sum += v;
+    edge_max = std::max(edge_max, v);
+  }
+  std::nth_element(values.begin(), values.begin() + length / 2, values.end());
+  f[kEdgeMean] = edge_sum / static_cast<float>(length);
+  f[kEdgeMax] = edge_max;
+  f[kEdgeMedian] = values[length / 2];
+  f[kBoundaryLength] = static_cast<float>(length);
+  f[kBoundaryOrientation] = static_cast<float>(std::abs(0.5 * std::atan2(2.0 * sxy, sxx - syy)));
+  f[kBoundaryY] = static_cast<float>(mean_y) * inv_height;
+
+  const RegionStats* small = &regions[pair[0]];
+  const RegionStats* large = &regions[pair[1]];
+  if (small->area > large->area) std::swap(small, large);
+  f[kAreaSmaller] = static_cast<float>(small->area);
+  f[kAreaLarger] = static_cast<float>(large->area);
+  double norm2 = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double diff = std::abs(small->sum_luv[c] / small->area - large->sum_luv[c] / large->area);
+    f[kLuvDiffL + c] = static_cast<float>(diff);
+    norm2 += diff * diff;
+  }
+  f[kLuvDiffNorm] = static_cast<float>(std::sqrt(norm2));
+  for (int c = 0; c < 3; ++c) {
+    f[kHueChi2 + c] = ChiSquaredDistance(small->hsv_hist.data() + c * kColourBins,
+                                         large->hsv_hist.data() + c * kColourBins, kColourBins);
+  }
+  f[kTextureChi2] =
+      ChiSquaredDistance(small->texture_hist.data(), large->texture_hist.data(), kTextureBins);
+  f[kVerticalOrder] =
+      static_cast<float>(small->sum_y / small->area - large->sum_y / large->area) * inv_height;
+}
+
+// Pairs per piece of the parallel feature loop: a real frame has ~16 000 pairs.
+constexpr int kPairsPerPiece = 1024;
+
+}  // namespace
+
+SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
+                                       const Superpixels& superpixels) {
+  SuperpixelPairs out;
+  // The regions' appearance and the boundary scan read the same labels and nothing of each
+  // other: on OpenCV's pool they run side by side (one after the other on one thread), each
+  // computing exactly what it computes alone.
+  std::vector<RegionStats> regions;
+  std::vector<cv::Point> boundary_points;
+  cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& tasks) {
+    for (int task = tasks.start; task < tasks.end; ++task) {
+      if (task == 0)
+        regions = ComputeRegionStats(image, superpixels.labels, superpixels.count);
+      else
+        boundary_points = ScanBoundaries(superpixels, out);
+    }
+  });
+  const PairPixels pixels = InvertToPairs(out, boundary_points);
   const int num_pairs = static_cast<int>(out.pairs.size());
-  std::vector<int> pair_offsets(static_cast<size_t>(num_pairs) + 1, 0);
-  for (int p : out.pixel_pairs) ++pair_offsets[p + 1];
-  for (int p = 0; p < num_pairs; ++p) pair_offsets[p + 1] += pair_offsets[p];
-  std::vector<cv::Point> pair_pixels(out.pixel_pairs.size());
-  {
-    std::vector<int> cursor(pair_offsets.begin(), pair_offsets.end() - 1);
-    for (size_t i = 0; i < boundary_points.size(); ++i) {
-      for (int k = out.pixel_offsets[i]; k < out.pixel_offsets[i + 1]; ++k) {
-        pair_pixels[cursor[out.pixel_pairs[k]]++] = boundary_points[i];
-      }
-    }
-  }
-
-  const std::vector<RegionStats> regions = ComputeRegionStats(image, labels, superpixels.count);
   out.features = cv::Mat1f(num_pairs, kNumOcclusionFeatures, 0.f);
-  const float inv_height = 1.f / static_cast<float>(height);
-  std::vector<float> values;
-  for (int p = 0; p < num_pairs; ++p) {
-    float* f = out.features[p];
-    const int begin = pair_offsets[p];
-    const int end = pair_offsets[p + 1];
-    const int length = end - begin;
-    values.clear();
-    double sum_x = 0.0;
-    double sum_y = 0.0;
-    for (int k = begin; k < end; ++k) {
-      const cv::Point pixel = pair_pixels[k];
-      values.push_back(enhanced_edge(pixel.y, pixel.x));
-      sum_x += pixel.x;
-      sum_y += pixel.y;
-    }
-    const double mean_x = sum_x / length;
-    const double mean_y = sum_y / length;
-    double sxx = 0.0;
-    double syy = 0.0;
-    double sxy = 0.0;
-    for (int k = begin; k < end; ++k) {
-      const double dx = pair_pixels[k].x - mean_x;
-      const double dy = pair_pixels[k].y - mean_y;
-      sxx += dx * dx;
-      syy += dy * dy;
-      sxy += dx * dy;
-    }
-    float edge_sum = 0.f;
-    float edge_max = 0.f;
-    for (float v : values) {
-      edge_sum += v;
-      edge_max = std::max(edge_max, v);
-    }
-    std::nth_element(values.begin(), values.begin() + length / 2, values.end());
-    f[kEdgeMean] = edge_sum / static_cast<float>(length);
-    f[kEdgeMax] = edge_max;
-    f[kEdgeMedian] = values[length / 2];
-    f[kBoundaryLength] = static_cast<float>(length);
-    f[kBoundaryOrientation] = static_cast<float>(std::abs(0.5 * std::atan2(2.0 * sxy, sxx - syy)));
-    f[kBoundaryY] = static_cast<float>(mean_y) * inv_height;
-
-    const RegionStats* small = &regions[out.pairs[p][0]];
-    const RegionStats* large = &regions[out.pairs[p][1]];
-    if (small->area > large->area) std::swap(small, large);
-    f[kAreaSmaller] = static_cast<float>(small->area);
-    f[kAreaLarger] = static_cast<float>(large->area);
-    double norm2 = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const double diff =
-          std::abs(small->sum_luv[c] / small->area - large->sum_luv[c] / large->area);
-      f[kLuvDiffL + c] = static_cast<float>(diff);
-      norm2 += diff * diff;
-    }
-    f[kLuvDiffNorm] = static_cast<float>(std::sqrt(norm2));
-    for (int c = 0; c < 3; ++c) {
-      f[kHueChi2 + c] = ChiSquaredDistance(small->hsv_hist.data() + c * kColourBins,
-                                           large->hsv_hist.data() + c * kColourBins, kColourBins);
-    }
-    f[kTextureChi2] =
-        ChiSquaredDistance(small->texture_hist.data(), large->texture_hist.data(), kTextureBins);
-    f[kVerticalOrder] =
-        static_cast<float>(small->sum_y / small->area - large->sum_y / large->area) * inv_height;
-  }
+  const float inv_height = 1.f / static_cast<float>(superpixels.labels.rows);
+  // Every pair writes only its own row.
+  const int pieces = (num_pairs + kPairsPerPiece - 1) / kPairsPerPiece;
+  cv::parallel_for_(cv::Range(0, pieces), [&](const cv::Range& range) {
+    std::vector<float> values;
+    for (int p = range.start * kPairsPerPiece; p < std::min(num_pairs, range.end * kPairsPerPiece);
+         ++p)
+      PairFeatures(enhanced_edge, pixels, regions, out.pairs[p], p, inv_height, values,
+                   out.features[p]);
+  });
   return out;
 }
 

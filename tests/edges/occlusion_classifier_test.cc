@@ -408,9 +408,16 @@ TEST_F(TrainedOcclusionTest, PaintIsTheSameOnOneThreadAndOnSeveral) {
   const int threads_before = cv::getNumThreads();
   cv::setNumThreads(1);
   const cv::Mat1f one = Painted(*classifier_, image, edge, grid);
+  const SuperpixelPairs pairs_one = ComputeSuperpixelPairs(image, edge, grid);
   cv::setNumThreads(3);
   const cv::Mat1f three = Painted(*classifier_, image, edge, grid);
+  const SuperpixelPairs pairs_three = ComputeSuperpixelPairs(image, edge, grid);
   cv::setNumThreads(threads_before);
+  // The pair features (region statistics beside the boundary scan, pairs in pieces) too.
+  EXPECT_EQ(pairs_one.pairs, pairs_three.pairs);
+  EXPECT_EQ(pairs_one.pixel_pairs, pairs_three.pixel_pairs);
+  ASSERT_EQ(pairs_one.features.size(), pairs_three.features.size());
+  EXPECT_EQ(cv::norm(pairs_one.features, pairs_three.features, cv::NORM_INF), 0.0);
   ASSERT_EQ(one.size(), image.size());
   ASSERT_EQ(three.size(), image.size());
   EXPECT_EQ(cv::countNonZero(one != three), 0);
