@@ -4,7 +4,9 @@
 #include <cmath>
 #include <numbers>
 #include <opencv2/core/hal/hal.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 namespace tod {
 
@@ -62,17 +64,22 @@ void WinningGradientRow(const float* up, const float* row, const float* down, in
   if (cols > 1) pixel(cols - 1, cols - 2, cols - 1);
 }
 
-// Runs `per_row(y, dx, dy)` with the winning differences of every row of `luv`.
+// Runs `per_row(y, dx, dy, scratch)` with the winning differences of every row of `luv` and a
+// scratch row of luv.cols floats. Rows only read `luv` and write their own outputs, so they run on
+// OpenCV's pool (as wide as the request's threads) with the same values for any width.
 template <typename PerRow>
-void ForEachGradientRow(const cv::Mat3f& luv, PerRow&& per_row) {
-  std::vector<float> dx(static_cast<std::size_t>(luv.cols));
-  std::vector<float> dy(static_cast<std::size_t>(luv.cols));
-  for (int y = 0; y < luv.rows; ++y) {
-    WinningGradientRow(luv.ptr<float>(std::max(y - 1, 0)), luv.ptr<float>(y),
-                       luv.ptr<float>(std::min(y + 1, luv.rows - 1)), luv.cols, dx.data(),
-                       dy.data());
-    per_row(y, dx.data(), dy.data());
-  }
+void ForEachGradientRow(const cv::Mat3f& luv, const PerRow& per_row) {
+  cv::parallel_for_(cv::Range(0, luv.rows), [&](const cv::Range& rows) {
+    std::vector<float> dx(static_cast<std::size_t>(luv.cols));
+    std::vector<float> dy(static_cast<std::size_t>(luv.cols));
+    std::vector<float> scratch(static_cast<std::size_t>(luv.cols));
+    for (int y = rows.start; y < rows.end; ++y) {
+      WinningGradientRow(luv.ptr<float>(std::max(y - 1, 0)), luv.ptr<float>(y),
+                         luv.ptr<float>(std::min(y + 1, luv.rows - 1)), luv.cols, dx.data(),
+                         dy.data());
+      per_row(y, dx.data(), dy.data(), scratch.data());
+    }
+  });
 }
 
 // Adds magnitude m with doubled-angle cosine / sine (c, s) to the 4 bins (see the header).
@@ -91,7 +98,7 @@ ColourGradient ComputeColourGradient(const cv::Mat3f& luv, bool with_orientation
   if (luv.empty()) return result;
   result.magnitude.create(luv.size());
   if (with_orientation) result.orientation.create(luv.size());
-  ForEachGradientRow(luv, [&](int y, const float* dx, const float* dy) {
+  ForEachGradientRow(luv, [&](int y, const float* dx, const float* dy, float*) {
     float* magnitude = result.magnitude.ptr<float>(y);
     for (int x = 0; x < luv.cols; ++x) magnitude[x] = std::sqrt(dx[x] * dx[x] + dy[x] * dy[x]);
     if (!with_orientation) return;
@@ -162,11 +169,9 @@ void AddGradientChannels(const cv::Mat3f& luv, bool halve, std::vector<cv::Mat1f
   cv::Mat1f magnitude(luv.size());
   std::array<cv::Mat1f, kOrientationBins> bins;
   for (cv::Mat1f& bin : bins) bin.create(luv.size());
-  std::vector<float> squared(static_cast<std::size_t>(luv.cols));
-  ForEachGradientRow(luv, [&](int y, const float* dx, const float* dy) {
-    GradientRowChannels(dx, dy, luv.cols, squared.data(), magnitude.ptr<float>(y),
-                        bins[0].ptr<float>(y), bins[1].ptr<float>(y), bins[2].ptr<float>(y),
-                        bins[3].ptr<float>(y));
+  ForEachGradientRow(luv, [&](int y, const float* dx, const float* dy, float* squared) {
+    GradientRowChannels(dx, dy, luv.cols, squared, magnitude.ptr<float>(y), bins[0].ptr<float>(y),
+                        bins[1].ptr<float>(y), bins[2].ptr<float>(y), bins[3].ptr<float>(y));
   });
   planes[first] = halve ? Halve(magnitude) : magnitude;
   for (int b = 0; b < kOrientationBins; ++b) {

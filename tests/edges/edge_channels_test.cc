@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <opencv2/core/utility.hpp>
 
 namespace tod {
 namespace {
@@ -102,6 +103,27 @@ TEST(EdgeChannels, HalfResolutionSizesAndVerticalStepResponse) {
   EXPECT_NEAR(channels.planes[kChanOrientFull + 2](row, step_cell), 0.f, 1e-6);
   EXPECT_NEAR(channels.planes[kChanL](row, 1), 0.f, 1e-4);
   EXPECT_NEAR(channels.planes[kChanL](row, 15), 1.f, 1e-3);
+}
+
+// The gradient rows run on OpenCV's pool: one thread and three give the same planes, bit for
+// bit, and the same colour gradient.
+TEST(EdgeChannels, OneThreadAndSeveralGiveTheSamePlanes) {
+  cv::Mat3b image(203, 311);
+  cv::RNG rng(3);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+  const int threads_before = cv::getNumThreads();
+  cv::setNumThreads(1);
+  const EdgeChannels one = ComputeEdgeChannels(image);
+  const ColourGradient gradient_one = ComputeColourGradient(BgrToLuv(image), true);
+  cv::setNumThreads(3);
+  const EdgeChannels three = ComputeEdgeChannels(image);
+  const ColourGradient gradient_three = ComputeColourGradient(BgrToLuv(image), true);
+  cv::setNumThreads(threads_before);
+  ASSERT_EQ(one.planes.size(), three.planes.size());
+  for (size_t p = 0; p < one.planes.size(); ++p)
+    EXPECT_EQ(cv::norm(one.planes[p], three.planes[p], cv::NORM_INF), 0.0) << "plane " << p;
+  EXPECT_EQ(cv::norm(gradient_one.magnitude, gradient_three.magnitude, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(gradient_one.orientation, gradient_three.orientation, cv::NORM_INF), 0.0);
 }
 
 TEST(EdgeChannels, EmptyImageGivesNoPlanes) {
