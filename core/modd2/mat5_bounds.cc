@@ -129,9 +129,11 @@ class Walker {
     // tagged int32, allocates 8 bytes per value its tag claims (a 424-byte file claiming a billion
     // dimensions made it allocate 8 GB). Tag checks that size against the container for every
     // class. An opaque object lays out the rest differently; libmatio 1.5.23 allocates nothing by
-    // its dimensions (tried with a claim of 1.9e9 elements), so the walk stops there.
+    // its dimensions (tried with a claim of 1.9e9 elements), but it does allocate what the next
+    // tag claims (a fuzzed 392-byte file made it allocate 2 GB for a name): the walk checks every
+    // remaining tag of an opaque object against its container, without interpreting them.
     if (Status s = Tag(&data, &type, &size, &dims); !s.ok()) return s;
-    if (array_class == kClassOpaque) return Status::Ok();
+    if (array_class == kClassOpaque) return TagsFit(data);
     uint64_t elements = 0;
     if (Status s = ElementCount(type, dims, &elements); !s.ok()) return s;
     if (Status s = Tag(&data, &type, &size, &name); !s.ok()) return s;
@@ -151,6 +153,16 @@ class Walker {
         }
         return Status::Ok();
     }
+  }
+
+  // Every data element of `data`, each checked against what is left of its container.
+  Status TagsFit(std::string_view data) const {
+    while (data.size() >= 8) {
+      uint32_t type = 0, size = 0;
+      std::string_view payload;
+      if (Status s = Tag(&data, &type, &size, &payload); !s.ok()) return s;
+    }
+    return Status::Ok();
   }
 
   // The product of int32 dimensions (two or more), saturated at 2^40: far more than any array

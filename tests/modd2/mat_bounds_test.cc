@@ -73,6 +73,13 @@ TEST(Mat5BoundsTest, FuzzerInputWithAHugeFunctionHandleArrayIsRefusedQuickly) {
   ExpectRefusedQuickly(CorpusInput("oom-4470bbbeaea222285e23e1cc994a3d7d31b5bd4c"));
 }
 
+// A 392-byte mutated seed found by CI's 5 s fuzz_smoke: the first variable is an opaque object
+// (class 17) whose third element's tag claims 2 GB; libmatio allocated that much for it (out of
+// memory under the fuzzer), and the walk used to stop at an opaque object's dimensions.
+TEST(Mat5BoundsTest, FuzzerInputWithAnOpaqueObjectClaimingAHugeNameIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("oom-2c3f1075e806a48cb08552a31be9c000ddd3ce32"));
+}
+
 // A 392-byte mutated seed found by CI's 5 s fuzz_smoke: the 'annotations' variable's tag claims 0
 // bytes, and libmatio read the struct header that follows anyway (1 x 687 million elements, two
 // fields) and allocated for it (out of memory under the fuzzer); the walk took those bytes for
