@@ -93,9 +93,7 @@ class StickyRefiner {
   StickyRefiner(const StickyImage& image, const StickyWeights& weights, std::vector<int>& labels)
       : image_(image), weights_(weights), labels_(labels) {}
 
-  std::vector<int>& labels() { return labels_; }
   std::vector<LabelSums>& sums() { return sums_; }
-  std::vector<RowExtent>& extents() { return extents_; }
 
   // Whether pixel i has a 4-neighbour of another label (only such pixels can move), decided from
   // the labels alone, before any edge value is loaded.
@@ -219,10 +217,10 @@ class StickyRefiner {
   }
 
  private:
-  // Labels whose sums strips of `parity` other than their own may touch: a label's pixels and
-  // their 4-neighbours lie within its extent grown by a row, and a strip's moves touch only the
-  // labels of its rows and of the row on either side (which belong to strips of the other parity,
-  // still during this half-sweep).
+  // Labels whose sums more than one strip of `parity` may touch. A strip's moves read and write
+  // the sums of the labels of its rows and of the row on either side (rows of strips of the other
+  // parity, which stand still meanwhile), so a label may be touched by every strip of `parity`
+  // whose rows, grown by one on each side, meet its extent.
   std::vector<char> SharedLabels(int strip_rows, int shift, int parity) const;
 
   const StickyImage& image_;
