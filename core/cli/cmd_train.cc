@@ -60,9 +60,17 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--edge-trees", args->train.edge_params.forest.num_trees,
                   "trees of the pixel edge classifier")
       ->check(CLI::Range(1, 200));
+  cmd->add_option("--edge-negatives", args->train.edge_params.negatives_per_positive,
+                  "pixel edge classifier: negative cells drawn per boundary cell of a frame "
+                  "(1 = balanced, ALGORITHM.md 3.4)")
+      ->check(CLI::Range(0.1, 1000.0));
   cmd->add_option("--occlusion-trees", args->train.occlusion_params.forest.num_trees,
                   "trees of the occlusion classifier")
       ->check(CLI::Range(1, 2000));
+  cmd->add_option("--occlusion-negatives", args->train.occlusion_params.negatives_per_positive,
+                  "occlusion classifier: negative superpixel pairs kept per obstacle-contour "
+                  "pair")
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--superpixel-strips", args->train.params.superpixels.strip_rows,
                   "sweep the sticky superpixels in strips of N rows, side by side on a "
                   "request's threads (0 = raster order, one thread: the default)")
@@ -76,6 +84,10 @@ Runner AddTrainCommand(CLI::App& app) {
                   "size filter ranges: ground_plane (every obstacle's size per row below a fitted "
                   "horizon, default) or bands (the authors' per-band min / max)")
       ->check(CLI::IsMember({"ground_plane", "bands"}));
+  cmd->add_option("--box-size-features", args->train.box_size_features,
+                  "proposal features 12-13: ground_plane (width and height over the rows below a "
+                  "fitted horizon, default) or paper (width and height over the image's)")
+      ->check(CLI::IsMember({"paper", "ground_plane"}));
   bool* correct = &args->train.prior_correction;
   cmd->add_flag_callback(
       "--no-prior-correction", [correct] { *correct = false; },

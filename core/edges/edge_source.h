@@ -54,7 +54,11 @@ Result<std::unique_ptr<EdgeSource>> CreateSedEdgeSource(const std::string& model
 // Channels, features and predictions live on the stride-2 grid of edge_channels.h (as SED's
 // stride 2); Compute() upsamples the grid bilinearly to the crop.
 struct PixelEdgeParams {
-  int samples_per_frame = 4000;  // balanced positives / negatives
+  int samples_per_frame = 4000;  // positives at most half of it
+  // Negatives drawn per positive of the same frame. 1 balances the classes (ALGORITHM.md §3.4);
+  // more shows the forest more of a real frame's textures, whose cells are thousands to one
+  // against boundary cells. The prior correction undoes any ratio (sampled_odds_scale).
+  double negatives_per_positive = 1.0;
   int boundary_radius = 2;
   // 16 trees, not SED's 8: a pixel forest has no structured output to average over a patch, so
   // its variance is all in the trees (README, "Real frames", point 9: 8 -> 16 trees lifted every
@@ -76,6 +80,8 @@ struct EdgeSamples {
   std::vector<float> targets;
   double positive_cells = 0;  // boundary cells available in the frames that gave samples
   double negative_cells = 0;
+  double positives_kept = 0;  // of them, sampled
+  double negatives_kept = 0;
 };
 // The samples of one training frame (seeded by frame_index); none when the frame has no boundary
 // or no non-boundary cell outside void.

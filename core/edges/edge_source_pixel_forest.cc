@@ -2,6 +2,7 @@
 // pipeline" step 1. Everything (channels, samples, predictions) lives on the stride-2 cell grid
 // of edge_channels.h, as SED evaluates at stride 2; Compute() upsamples bilinearly.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <opencv2/core/utility.hpp>
@@ -57,6 +58,10 @@ Result<EdgeSamples> ExtractEdgeSamples(const EdgeTrainingFrame& frame,
   if (params.samples_per_frame < 2) {
     return Status::InvalidArgument("pixel edge training: samples_per_frame must be >= 2");
   }
+  if (!(params.negatives_per_positive > 0.0 && params.negatives_per_positive <= 1000.0)) {
+    return Status::InvalidArgument(
+        "pixel edge training: negatives_per_positive must be in (0, 1000]");
+  }
   if (Status status = CheckFrame(frame, frame_index); !status.ok()) return status;
   const int num_features = NumPixelFeatures();
   const std::size_t per_class = static_cast<std::size_t>(params.samples_per_frame / 2);
@@ -73,16 +78,24 @@ Result<EdgeSamples> ExtractEdgeSamples(const EdgeTrainingFrame& frame,
           .push_back(index);
     }
   }
-  // Same number of each class from every frame, so the forest's mean is a balanced probability.
-  const std::size_t count = std::min({per_class, positive_cells.size(), negative_cells.size()});
-  if (count == 0) return out;
+  // The same number of positives as the frame has negatives to match (negatives_per_positive
+  // of them each), so every frame weighs alike in both classes.
+  const double ratio = params.negatives_per_positive;
+  const std::size_t positives =
+      std::min({per_class, positive_cells.size(),
+                static_cast<std::size_t>(static_cast<double>(negative_cells.size()) / ratio)});
+  const std::size_t negatives =
+      std::min(negative_cells.size(), static_cast<std::size_t>(std::llround(ratio * positives)));
+  if (positives == 0 || negatives == 0) return out;
   out.positive_cells = static_cast<double>(positive_cells.size());
   out.negative_cells = static_cast<double>(negative_cells.size());
+  out.positives_kept = static_cast<double>(positives);
+  out.negatives_kept = static_cast<double>(negatives);
   std::mt19937_64 rng(params.forest.seed * 0x9E3779B97F4A7C15ULL + frame_index);
   const EdgeChannels channels = ComputeEdgeChannels(frame.image, params.channels);
   const PixelFeatureExtractor extractor(channels);
   const int cols = channels.cols();
-  const auto add_samples = [&](std::vector<int> pool, float target) {
+  const auto add_samples = [&](std::vector<int> pool, std::size_t count, float target) {
     for (const int index : SampleWithoutReplacement(std::move(pool), count, rng)) {
       cv::Mat1f row(1, num_features);
       extractor.Extract(index / cols, index % cols, row.ptr<float>(0));
@@ -90,8 +103,8 @@ Result<EdgeSamples> ExtractEdgeSamples(const EdgeTrainingFrame& frame,
       out.targets.push_back(target);
     }
   };
-  add_samples(std::move(positive_cells), 1.f);
-  add_samples(std::move(negative_cells), 0.f);
+  add_samples(std::move(positive_cells), positives, 1.f);
+  add_samples(std::move(negative_cells), negatives, 0.f);
   return out;
 }
 
@@ -102,6 +115,8 @@ void AppendEdgeSamples(EdgeSamples& into, const EdgeSamples& more) {
   into.targets.insert(into.targets.end(), more.targets.begin(), more.targets.end());
   into.positive_cells += more.positive_cells;
   into.negative_cells += more.negative_cells;
+  into.positives_kept += more.positives_kept;
+  into.negatives_kept += more.negatives_kept;
 }
 
 Result<PixelEdgeClassifier> PixelEdgeClassifier::TrainOnSamples(const EdgeSamples& samples,
@@ -115,9 +130,12 @@ Result<PixelEdgeClassifier> PixelEdgeClassifier::TrainOnSamples(const EdgeSample
   if (!forest.ok()) return forest.status().WithContext("pixel edge training");
   classifier.forest_ = std::move(forest).value();
   classifier.channel_params_ = params.channels;
-  // Equal counts per class from every frame: negatives were kept at count / negatives available,
-  // positives at count / positives available, so the odds factor is the ratio of availabilities.
-  classifier.sampled_odds_scale_ = samples.positive_cells / samples.negative_cells;
+  // The odds factor that undoes the sampling: (share of negative cells kept) / (share of
+  // boundary cells kept), over all frames.
+  // Written as (P / N) * (kept negatives / kept positives) so that balanced samples give P / N
+  // exactly.
+  classifier.sampled_odds_scale_ = (samples.positive_cells / samples.negative_cells) *
+                                   (samples.negatives_kept / samples.positives_kept);
   if (classifier.forest_.empty()) {
     return Status::Internal("pixel edge training: the forest trainer returned no trees");
   }

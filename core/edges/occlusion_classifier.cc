@@ -17,7 +17,6 @@ namespace {
 constexpr std::string_view kMagic("TODOCCL\0", 8);
 constexpr std::uint32_t kFormatVersion = 1;
 // Negatives kept per positive when balancing the training pairs (§3.4 step 4).
-constexpr size_t kNegativesPerPositive = 4;
 
 Status ValidateMaps(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
                     const Superpixels& superpixels, const std::string& what) {
@@ -116,6 +115,9 @@ Status ValidateOcclusionParams(const OcclusionParams& params) {
   if (!(params.max_void_fraction >= 0.0 && params.max_void_fraction <= 1.0)) {
     return Status::InvalidArgument("occlusion params.max_void_fraction must be in [0,1]");
   }
+  if (params.negatives_per_positive < 1 || params.negatives_per_positive > 1000) {
+    return Status::InvalidArgument("occlusion params.negatives_per_positive must be in [1,1000]");
+  }
   return Status::Ok();
 }
 
@@ -172,11 +174,11 @@ Result<OcclusionSamples> ExtractOcclusionSamples(const OcclusionTrainingFrame& f
     out.positive_rows.insert(out.positive_rows.end(), row, row + kNumOcclusionFeatures);
     out.positive_targets.push_back(obstacle_side ? 1.f : 0.5f);
   }
-  // A frame keeps at most kNegativesPerPositive negatives per positive (at least a few hundred),
+  // A frame keeps at most negatives_per_positive negatives per positive (at least a few hundred),
   // so that a trainer streaming a thousand frames holds samples, not every pair of every frame.
   const std::size_t available = out.negative_rows.size() / kNumOcclusionFeatures;
-  const std::size_t cap =
-      std::max<std::size_t>(kNegativesPerPositive * out.positive_targets.size(), 256);
+  const std::size_t cap = std::max<std::size_t>(
+      static_cast<std::size_t>(params.negatives_per_positive) * out.positive_targets.size(), 256);
   KeepRandomRows(out.negative_rows, std::min(available, cap),
                  params.forest.seed * 0x9E3779B97F4A7C15ULL + frame_index);
   out.negatives_available = static_cast<double>(available);
@@ -202,8 +204,10 @@ Result<OcclusionClassifier> OcclusionClassifier::FitOnSamples(OcclusionSamples s
         "occlusion training: no obstacle contour among the superpixel pairs (are there obstacles "
         "in the training frames?)");
   }
-  // Balance: all positives, at most kNegativesPerPositive negatives each (a seeded subset).
-  KeepRandomRows(samples.negative_rows, kNegativesPerPositive * num_positive, params.forest.seed);
+  // Balance: all positives, at most negatives_per_positive negatives each (a seeded subset).
+  KeepRandomRows(samples.negative_rows,
+                 static_cast<std::size_t>(params.negatives_per_positive) * num_positive,
+                 params.forest.seed);
   const size_t num_negative = samples.negative_rows.size() / kNumOcclusionFeatures;
   cv::Mat1f features(static_cast<int>(num_positive + num_negative), kNumOcclusionFeatures);
   std::copy(samples.positive_rows.begin(), samples.positive_rows.end(), features[0]);

@@ -23,6 +23,9 @@ struct OcclusionParams {
   // a real frame (README, "Real frames", point 10).
   ForestParams forest{.num_trees = 200, .max_features = 0, .min_leaf_size = 5};
   double max_void_fraction = 0.5;  // skip training pairs with a side more void than this
+  // Negative pairs kept per obstacle-contour pair (a frame keeps at least 256). The prior
+  // correction undoes the ratio (sampled_odds_scale).
+  int negatives_per_positive = 4;
 };
 
 struct OcclusionTrainingFrame {

@@ -177,8 +177,15 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
   f[8] = static_cast<float>(static_cast<double>(w) / h);
   f[10] = static_cast<float>((x_for_centre + w / 2.0) / image_w);
   f[11] = static_cast<float>((y_for_centre + h / 2.0) / image_h);
-  f[12] = static_cast<float>(w / image_w);
-  f[13] = static_cast<float>(h / image_h);
+  if (options_.horizon_y) {
+    const double below_horizon =
+        std::max(1.0, origin_.y + r.y + h / 2.0 - *options_.horizon_y);  // full-image rows
+    f[12] = static_cast<float>(w / below_horizon);
+    f[13] = static_cast<float>(h / below_horizon);
+  } else {
+    f[12] = static_cast<float>(w / image_w);
+    f[13] = static_cast<float>(h / image_h);
+  }
 
   // Features 15-17: population standard deviation of H, S, V.
   const cv::Point to_colour = region_in_colour_.tl();

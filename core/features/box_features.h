@@ -26,6 +26,7 @@
 #include <array>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "core/base/status.h"
@@ -48,6 +49,10 @@ struct BoxFeatureOptions {
   // histogram exactly (slower on large boxes, same values on small ones).
   bool exact_contrast = false;
   int contrast_snap_min_area = 128 * 128;  // grown-box pixels from which snapping applies
+  // Features 12-13 as a physical size (PipelineParams::box_features): when set, w / d and h / d
+  // with d = box centre row − *horizon_y in full-image pixels, at least 1. Unset: w and h over
+  // the image's (the paper's).
+  std::optional<double> horizon_y = std::nullopt;
 };
 
 class BoxFeatureExtractor {

@@ -46,4 +46,14 @@ FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height)
   return g;
 }
 
+BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height) {
+  BoxFeatureOptions options;
+  const BoxFeatureParams& params = bundle.params.box_features;
+  if (!params.ground_plane_size) return options;
+  const MultilayerRegions& trained = bundle.regions;
+  const FrameMapping m = MappingForFrame(trained.image_width, trained.image_height, width, height);
+  options.horizon_y = params.horizon_y * m.scale + m.dy;
+  return options;
+}
+
 }  // namespace tod

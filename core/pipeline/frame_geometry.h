@@ -10,6 +10,7 @@
 // Regions are clipped to the frame.
 #pragma once
 
+#include "core/features/box_features.h"
 #include "core/pipeline/model_bundle.h"
 
 namespace tod {
@@ -31,5 +32,9 @@ struct FrameGeometry {
   SizeFilter size_filter;
 };
 FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height);
+
+// The proposal features' options of a bundle for frames of a given size: the ground-plane
+// horizon (PipelineParams::box_features) mapped like the regions' rows.
+BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height);
 
 }  // namespace tod

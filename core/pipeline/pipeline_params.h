@@ -27,6 +27,20 @@ struct PriorCorrection {
   double occlusion_odds = 1.0;  // c of the occlusion classifier
 };
 
+// Features 12-13 of a proposal (§5: width and height over the image's). With few training
+// frames the regressors see obstacles at a few distances only, and a box's absolute size then
+// says "as far as the training obstacles stood": a near obstacle, larger than any they saw, is
+// scored like the large boxes of road and background (README, "Real frames"). On a flat road an
+// object's image size is its physical size times its distance below the horizon (the ground-plane
+// size prior fits that horizon), so with ground_plane_size the two features are w / d and h / d,
+// d = box centre row − horizon_y (at least 1 px): a physical size that every training obstacle
+// informs at every distance. horizon_y is in the training frame's pixels (frame_geometry.h maps
+// it to other frame sizes). Off: the paper's features.
+struct BoxFeatureParams {
+  bool ground_plane_size = false;
+  double horizon_y = 0.0;
+};
+
 // p -> p·c / (p·c + 1 - p) on every pixel in place (0 stays 0, 1 stays 1; c = 1: unchanged).
 void CorrectSampledPrior(cv::Mat1f& probability, double odds_scale);
 
@@ -61,6 +75,7 @@ struct PipelineParams {
   ObstacleCalibration obstacle_calibration;  // fitted by `tod train`
   FusionParams fusion;
   ProbabilityMapParams probability_map;
+  BoxFeatureParams box_features;
 };
 
 nlohmann::json ToJson(const PipelineParams& params);

@@ -11,7 +11,8 @@ namespace tod {
 ProposalFeatureComputer::ProposalFeatureComputer(const cv::Mat3b& image,
                                                  const OcclusionEdges& oaocc,
                                                  const MultilayerRegions& regions,
-                                                 const ProposalSet& proposals, int threads)
+                                                 const ProposalSet& proposals,
+                                                 const BoxFeatureOptions& options, int threads)
     : proposals_(proposals), per_region_(regions.num_layers()) {
   if (proposals.boxes.empty()) return;
   std::vector<bool> used(regions.num_layers(), false);
@@ -24,7 +25,7 @@ ProposalFeatureComputer::ProposalFeatureComputer(const cv::Mat3b& image,
          const Box region = Intersect(regions.layers[k], oaocc.r1);
          per_region_[k] = std::make_unique<const BoxFeatureExtractor>(
              frame_colour, RegionEdgeMap(oaocc, regions, k), cv::Point(region.x, region.y),
-             image.size());
+             image.size(), options);
          return Status::Ok();
        }))
     if (!s.ok()) throw std::runtime_error(s.ToString());
@@ -47,9 +48,10 @@ void ProposalFeatureComputer::ComputeRange(std::size_t begin, std::size_t end,
 }
 
 cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
-                                  const MultilayerRegions& regions, const ProposalSet& proposals) {
+                                  const MultilayerRegions& regions, const ProposalSet& proposals,
+                                  const BoxFeatureOptions& options) {
   cv::Mat1f rows(static_cast<int>(proposals.boxes.size()), kNumBoxFeatures, 0.f);
-  ProposalFeatureComputer(image, oaocc, regions, proposals)
+  ProposalFeatureComputer(image, oaocc, regions, proposals, options)
       .ComputeRange(0, proposals.boxes.size(), rows);
   return rows;
 }

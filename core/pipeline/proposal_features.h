@@ -26,7 +26,7 @@ class ProposalFeatureComputer {
   // on OpenCV's pool, cv::setNumThreads), the same for any count.
   ProposalFeatureComputer(const cv::Mat3b& image, const OcclusionEdges& oaocc,
                           const MultilayerRegions& regions, const ProposalSet& proposals,
-                          int threads = 1);
+                          const BoxFeatureOptions& options, int threads = 1);
   // Rows [begin, end) of `out` (proposals x kNumBoxFeatures) for proposals [begin, end).
   void ComputeRange(std::size_t begin, std::size_t end, cv::Mat1f& out) const;
 
@@ -37,6 +37,7 @@ class ProposalFeatureComputer {
 
 // One row of 20 features per proposal.
 cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
-                                  const MultilayerRegions& regions, const ProposalSet& proposals);
+                                  const MultilayerRegions& regions, const ProposalSet& proposals,
+                                  const BoxFeatureOptions& options);
 
 }  // namespace tod

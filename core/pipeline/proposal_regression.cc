@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/parallel.h"
 #include "core/pipeline/probability_map.h"
 #include "core/pipeline/proposal_features.h"
@@ -43,7 +44,9 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   const std::size_t n = proposals.boxes.size();
   cv::Mat1f features(static_cast<int>(n), kNumBoxFeatures, 0.f);
   out.ordr.assign(n, 0.f);
-  const ProposalFeatureComputer computer(image, oaocc, regions, proposals, limits.threads);
+  const ProposalFeatureComputer computer(image, oaocc, regions, proposals,
+                                         FeatureOptionsForFrame(bundle, image.cols, image.rows),
+                                         limits.threads);
   std::size_t done = 0;
   Clock::duration feature_time{};
   while (done < n) {

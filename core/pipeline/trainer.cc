@@ -170,6 +170,34 @@ Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, ModelBundle& bun
   return Status::Ok();
 }
 
+// With ground-plane size features (PipelineParams::box_features), their horizon: the one the
+// ground-plane size prior fits to the training obstacles, whatever the size filter's recipe.
+Status PlaceFeatureHorizon(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
+                           nlohmann::json& parts) {
+  const std::string& choice = run.options().box_size_features;
+  if (choice != "ground_plane" && choice != "paper")
+    return Status::InvalidArgument("--box-size-features must be ground_plane or paper, got '" +
+                                   choice + "'");
+  BoxFeatureParams& features = bundle.params.box_features;
+  features.ground_plane_size = choice == "ground_plane";
+  if (!features.ground_plane_size) {
+    parts["box_features"] = {{"size", "paper"}};
+    return Status::Ok();
+  }
+  const auto prior = FitGroundPlaneSizePrior(survey.obstacle_boxes);
+  if (!prior.ok())
+    return prior.status().WithContext(
+        "placing the horizon of the ground-plane size features (too few obstacles? "
+        "--box-size-features paper needs none)");
+  features.horizon_y = prior->horizon_y;
+  parts["box_features"] = {{"size", "ground_plane"}, {"horizon_y", features.horizon_y}};
+  char line[96];
+  std::snprintf(line, sizeof line, "box features 12-13: w/d, h/d below the horizon at row %.1f",
+                features.horizon_y);
+  run.Say(line);
+  return Status::Ok();
+}
+
 // Multilayer regions and the size filter from the training obstacles (§1.4, §4.3).
 Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
                       nlohmann::json& parts) {
@@ -194,6 +222,7 @@ Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundl
                                    "'");
   }
   bundle.size_filter.enabled = options.params.size_filter;
+  if (Status st = PlaceFeatureHorizon(run, survey, bundle, parts); !st.ok()) return st;
   for (int k = 0; k < bundle.regions.num_layers(); ++k) {
     const Box& r = bundle.regions.layers[k];
     char line[96];  // snprintf: GCC 12 warns (-Wrestrict, falsely) on "R" + std::to_string
@@ -339,7 +368,8 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
                     {"frames", which.size()},
                     {"samples", samples},
                     {"prior_odds", bundle.params.prior_correction.edge_odds},
-                    {"trees", edge_params.forest.num_trees}};
+                    {"trees", edge_params.forest.num_trees},
+                    {"negatives_per_positive", edge_params.negatives_per_positive}};
   bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*classifier));
   return TrainFoldCopies(folds, which, "pixel edge classifier", fit,
                          [&](ModelBundle& upstream, PixelEdgeClassifier copy) {
@@ -404,7 +434,8 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
                         {"contour_pairs", positives},
                         {"edge_maps", folds.enabled ? "out_of_fold" : "in_sample"},
                         {"prior_odds", bundle.params.prior_correction.occlusion_odds},
-                        {"trees", params.forest.num_trees}};
+                        {"trees", params.forest.num_trees},
+                        {"negatives_per_positive", params.negatives_per_positive}};
   return Status::Ok();
 }
 
@@ -465,10 +496,12 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
               SelectTrainingSamples(ranked, s, limits, options.selection,
                                     options.seed * 1000003ULL + static_cast<unsigned>(i));
           if (!selected.ok()) return selected.status();
+          const BoxFeatureOptions features =
+              FeatureOptionsForFrame(bundle, s.image.cols, s.image.rows);
           out.ordr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
-                                                     Subset(all, selected->ordr_indices));
+                                                     Subset(all, selected->ordr_indices), features);
           out.obdr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
-                                                     Subset(all, selected->obdr_indices));
+                                                     Subset(all, selected->obdr_indices), features);
           out.ordr_targets[i] = selected->ordr_targets;
           out.obdr_targets[i] = selected->obdr_targets;
         }

@@ -159,19 +159,24 @@ TEST_F(MasksCliTest, HardNegativeMiningByDefaultOneRoundOnRequest) {
 // records; out of range is refused before any work.
 TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   const std::string model = (out_ / "trees").string();
-  const CommandResult run = RunCommand(Train(
-      model, "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2 --superpixel-strips 16"));
+  const CommandResult run = RunCommand(
+      Train(model,
+            "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2 --superpixel-strips 16 "
+            "--edge-negatives 3 --occlusion-negatives 6"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json manifest = Manifest(model);
   EXPECT_EQ(manifest["params"]["superpixels"]["strip_rows"], 16);
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 4);
   EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 12);
+  EXPECT_EQ(manifest["training"]["parts"]["edges"]["negatives_per_positive"], 3.0);
+  EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["negatives_per_positive"], 6);
   // The regressors' negatives per frame and range: twice the paper's 17 (ORDR) and 25 (OBDR).
   EXPECT_EQ(manifest["training"]["parts"]["ordr"]["negatives_per_range"],
             nlohmann::json({34, 34, 34, 34}));
   EXPECT_EQ(manifest["training"]["parts"]["obdr"]["negatives_per_range"],
             nlohmann::json({50, 50, 50, 50}));
-  for (const char* flag : {"--edge-trees 0", "--negatives-scale 0", "--superpixel-strips -1"}) {
+  for (const char* flag : {"--edge-trees 0", "--negatives-scale 0", "--superpixel-strips -1",
+                           "--edge-negatives 0", "--occlusion-negatives 0"}) {
     const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), flag));
     EXPECT_NE(wrong.exit_code, 0) << flag;
     EXPECT_NE(wrong.output.find(std::string(flag).substr(0, std::string(flag).find(' '))),
@@ -181,13 +186,42 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   }
 }
 
+// --box-size-features chooses features 12-13: the manifest keeps the choice and the horizon it
+// divides by (the ground-plane prior's), and an unknown choice is refused before any work.
+TEST_F(MasksCliTest, BoxSizeFeaturesAreAChoiceAndRecorded) {
+  for (const std::string choice : {"paper", "ground_plane"}) {
+    const std::string model = (out_ / ("size_" + choice)).string();
+    const CommandResult run = RunCommand(Train(model, "--box-size-features " + choice));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json manifest = Manifest(model);
+    const bool ground = choice == "ground_plane";
+    EXPECT_EQ(manifest["params"]["box_features"]["ground_plane_size"], ground);
+    EXPECT_EQ(manifest["training"]["parts"]["box_features"]["size"], choice);
+    if (ground) {
+      EXPECT_EQ(manifest["params"]["box_features"]["horizon_y"],
+                manifest["training"]["parts"]["size_filter"]["horizon_y"]);
+      EXPECT_NE(run.output.find("box features 12-13"), std::string::npos) << run.output;
+    }
+    // The bundle runs: detect reads the choice back from the manifest.
+    const CommandResult detect = RunCommand(tod_ + " detect --model " + model + " --out " +
+                                            (out_ / ("detect_" + choice)).string() + " " +
+                                            (*root_ / "images" / "2.png").string());
+    EXPECT_EQ(detect.exit_code, 0) << detect.output;
+  }
+  const CommandResult wrong =
+      RunCommand(Train((out_ / "wrong").string(), "--box-size-features metres"));
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_NE(wrong.output.find("box-size-features"), std::string::npos) << wrong.output;
+  EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
+}
+
 // --size-filter-recipe bands restores the authors' per-band extremes (three bands); the manifest
 // names the recipe, and an unknown recipe is refused before any work.
 TEST_F(MasksCliTest, SizeFilterRecipeIsAChoiceAndRecorded) {
   const std::string model = (out_ / "bands").string();
   const CommandResult run = RunCommand(Train(model, "--size-filter-recipe bands"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_EQ(run.output.find("horizon at row"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("size filter: horizon at row"), std::string::npos) << run.output;
   std::ifstream in(fs::path(model) / "manifest.json");
   const nlohmann::json manifest = nlohmann::json::parse(in);
   EXPECT_EQ(manifest["training"]["parts"]["size_filter"]["recipe"], "bands");

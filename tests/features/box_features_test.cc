@@ -252,6 +252,37 @@ TEST(BoxFeaturesTest, RegionOriginOffsetAndClipping) {
   EXPECT_NEAR(f[12], 3.0 / 40.0, kTol);
 }
 
+// With a horizon, features 12-13 are the box's width and height over its centre's rows below it,
+// so the same physical size gives the same values at any distance; nothing else changes.
+TEST(BoxFeaturesTest, GroundPlaneSizeDividesByTheRowsBelowTheHorizon) {
+  const cv::Point origin(10, 20);
+  const cv::Size image(40, 50);
+  const BoxFeatureExtractor paper(ThreeBoundaryMap(), Uniform(8, 8, {0, 0, 255}), origin, image);
+  const BoxFeatureExtractor ground(ThreeBoundaryMap(), Uniform(8, 8, {0, 0, 255}), origin, image,
+                                   {.horizon_y = 12.0});
+  // Centre row 20 + 2 = 22, 10 rows below the horizon.
+  const BoxFeatureVector p = paper.Compute({15, 20, 3, 4}, 0.f);
+  const BoxFeatureVector g = ground.Compute({15, 20, 3, 4}, 0.f);
+  EXPECT_NEAR(g[12], 3.0 / 10.0, kTol);
+  EXPECT_NEAR(g[13], 4.0 / 10.0, kTol);
+  for (int i = 0; i < kNumBoxFeatures; ++i) {
+    if (i != 12 && i != 13) {
+      EXPECT_FLOAT_EQ(g[i], p[i]) << "feature " << i;
+    }
+  }
+  // The divisor follows each box's own centre row.
+  const BoxFeatureExtractor lower(ThreeBoundaryMap(), Uniform(8, 8, {0, 0, 255}), origin, image,
+                                  {.horizon_y = 17.0});
+  EXPECT_NEAR(lower.Compute({12, 20, 4, 8}, 0.f)[13], 8.0 / 7.0, kTol);  // centre row 24
+  EXPECT_NEAR(lower.Compute({12, 20, 2, 4}, 0.f)[13], 4.0 / 5.0, kTol);  // centre row 22
+  // A box above the horizon divides by one row, not by zero or a negative count.
+  const BoxFeatureExtractor above(ThreeBoundaryMap(), Uniform(8, 8, {0, 0, 255}), origin, image,
+                                  {.horizon_y = 40.0});
+  const BoxFeatureVector a = above.Compute({15, 20, 3, 4}, 0.f);
+  EXPECT_FLOAT_EQ(a[12], 3.f);
+  EXPECT_FLOAT_EQ(a[13], 4.f);
+}
+
 TEST(BoxFeaturesTest, ComputeAllMatchesCompute) {
   const BoxFeatureExtractor extractor(ThreeBoundaryMap(), Uniform(8, 8, {10, 200, 30}), {0, 0},
                                       {8, 8});

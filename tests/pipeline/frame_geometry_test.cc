@@ -51,6 +51,17 @@ TEST(FrameGeometryTest, WiderAspectScalesByWidthAndKeepsRowsAboutTheCentre) {
   EXPECT_DOUBLE_EQ(b.area_max, 10000 * 0.9375 * 0.9375);
 }
 
+// The ground-plane features' horizon is a row of the training frame: it moves with the rows.
+TEST(FrameGeometryTest, FeatureHorizonMapsLikeTheRows) {
+  ModelBundle bundle = BundleAt2048x1024();
+  EXPECT_FALSE(FeatureOptionsForFrame(bundle, 2048, 1024).horizon_y.has_value());
+  bundle.params.box_features = {.ground_plane_size = true, .horizon_y = 397.0};
+  EXPECT_DOUBLE_EQ(*FeatureOptionsForFrame(bundle, 2048, 1024).horizon_y, 397.0);
+  EXPECT_DOUBLE_EQ(*FeatureOptionsForFrame(bundle, 1920, 1080).horizon_y, 397.0 * 0.9375 + 60);
+  EXPECT_DOUBLE_EQ(*FeatureOptionsForFrame(bundle, 1280, 720).horizon_y,
+                   397.0 * 0.625 + (360 - 0.625 * 512));
+}
+
 TEST(FrameGeometryTest, SmallerFrameScalesEverythingByOneFactor) {
   const FrameGeometry g = GeometryForFrame(BundleAt2048x1024(), 1280, 720);
   const double s = 0.625, dy = 360 - 0.625 * 512;
