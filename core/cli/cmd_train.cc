@@ -85,8 +85,8 @@ Runner AddTrainCommand(CLI::App& app) {
                   "horizon, default) or bands (the authors' per-band min / max)")
       ->check(CLI::IsMember({"ground_plane", "bands"}));
   cmd->add_option("--box-size-features", args->train.box_size_features,
-                  "proposal features 12-13: ground_plane (width and height over the rows below a "
-                  "fitted horizon, default) or paper (width and height over the image's)")
+                  "proposal features 10, 12, 13: ground_plane (column offset, width and height "
+                  "over the rows below a fitted horizon, default) or paper (over the image's size)")
       ->check(CLI::IsMember({"paper", "ground_plane"}));
   bool* correct = &args->train.prior_correction;
   cmd->add_flag_callback(

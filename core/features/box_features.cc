@@ -175,14 +175,19 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
   const int y_for_centre = options_.region_relative_centre ? r.y : r.y + origin_.y;
   f[7] = static_cast<float>(area / (image_w * image_h));
   f[8] = static_cast<float>(static_cast<double>(w) / h);
-  f[10] = static_cast<float>((x_for_centre + w / 2.0) / image_w);
   f[11] = static_cast<float>((y_for_centre + h / 2.0) / image_h);
   if (options_.horizon_y) {
+    // On a flat road, image lengths at d rows below the horizon are physical lengths times d
+    // (over the camera height): the centre's offset from the middle column (the principal point,
+    // as frame_geometry.h assumes) over d is how far to the side the box stands, and w / d, h / d
+    // its physical size, the same at every distance.
     const double below_horizon =
         std::max(1.0, origin_.y + r.y + h / 2.0 - *options_.horizon_y);  // full-image rows
+    f[10] = static_cast<float>((origin_.x + r.x + w / 2.0 - image_w / 2.0) / below_horizon);
     f[12] = static_cast<float>(w / below_horizon);
     f[13] = static_cast<float>(h / below_horizon);
   } else {
+    f[10] = static_cast<float>((x_for_centre + w / 2.0) / image_w);
     f[12] = static_cast<float>(w / image_w);
     f[13] = static_cast<float>(h / image_h);
   }

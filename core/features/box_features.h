@@ -43,15 +43,17 @@ using BoxFeatureVector = std::array<float, kNumBoxFeatures>;
 struct BoxFeatureOptions {
   // ALGORITHM.md §5 "coordinates quirk": the original code computed features 10-11 from
   // region-relative box coordinates. Off by default (full-image coordinates, [R]); the flag
-  // exists to reproduce models trained the old way. Features 12-13 do not depend on it.
+  // exists to reproduce models trained the old way. Features 12-13 do not depend on it, nor does
+  // feature 10 with a horizon (full-image columns).
   bool region_relative_centre = false;
   // Colour contrast of large boxes (see the top of this file). exact_contrast = true counts every
   // histogram exactly (slower on large boxes, same values on small ones).
   bool exact_contrast = false;
   int contrast_snap_min_area = 128 * 128;  // grown-box pixels from which snapping applies
-  // Features 12-13 as a physical size (PipelineParams::box_features): when set, w / d and h / d
-  // with d = box centre row − *horizon_y in full-image pixels, at least 1. Unset: w and h over
-  // the image's (the paper's).
+  // Features 10, 12, 13 as a physical position and size (PipelineParams::box_features): when
+  // set, (centre column − middle column) / d, w / d and h / d with d = box centre row −
+  // *horizon_y in full-image pixels, at least 1. Unset: the centre column, w and h over the
+  // image's width and height (the paper's).
   std::optional<double> horizon_y = std::nullopt;
 };
 

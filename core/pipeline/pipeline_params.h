@@ -27,15 +27,16 @@ struct PriorCorrection {
   double occlusion_odds = 1.0;  // c of the occlusion classifier
 };
 
-// Features 12-13 of a proposal (§5: width and height over the image's). With few training
-// frames the regressors see obstacles at a few distances only, and a box's absolute size then
-// says "as far as the training obstacles stood": a near obstacle, larger than any they saw, is
-// scored like the large boxes of road and background (README, "Real frames"). On a flat road an
-// object's image size is its physical size times its distance below the horizon (the ground-plane
-// size prior fits that horizon), so with ground_plane_size the two features are w / d and h / d,
-// d = box centre row − horizon_y (at least 1 px): a physical size that every training obstacle
-// informs at every distance. horizon_y is in the training frame's pixels (frame_geometry.h maps
-// it to other frame sizes). Off: the paper's features.
+// Features 10, 12 and 13 of a proposal (§5: centre column, width and height over the image's).
+// With few training frames the regressors see obstacles at a few distances only, and a box's
+// pixel size and column then say "as far as the training obstacles stood": a near obstacle,
+// larger than any they saw, is scored like the large boxes of road and background (README, "Real
+// frames", point 11). On a flat road image lengths are physical lengths times the distance below
+// the horizon (the ground-plane size prior fits that horizon), so with ground_plane_size the
+// features are (centre column − middle column) / d, w / d and h / d, d = box centre row −
+// horizon_y (at least 1 px): a lateral position and a size that every training obstacle informs
+// at every distance. horizon_y is in the training frame's pixels (frame_geometry.h maps it to
+// other frame sizes). Off: the paper's features.
 struct BoxFeatureParams {
   bool ground_plane_size = false;
   double horizon_y = 0.0;

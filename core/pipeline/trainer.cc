@@ -192,7 +192,7 @@ Status PlaceFeatureHorizon(TrainingRun& run, const Survey& survey, ModelBundle& 
   features.horizon_y = prior->horizon_y;
   parts["box_features"] = {{"size", "ground_plane"}, {"horizon_y", features.horizon_y}};
   char line[96];
-  std::snprintf(line, sizeof line, "box features 12-13: w/d, h/d below the horizon at row %.1f",
+  std::snprintf(line, sizeof line, "box features 10, 12, 13: x/d, w/d, h/d below row %.1f",
                 features.horizon_y);
   run.Say(line);
   return Status::Ok();

@@ -33,8 +33,9 @@ struct TrainOptions {
   // every obstacle through h, w, area per row below a fitted horizon, ground_plane_size_prior.h)
   // or bands (the authors' per-band min / max, §4.3).
   std::string size_filter_recipe = "ground_plane";
-  // Proposal features 12-13 (PipelineParams::box_features): ground_plane (ours; width and height
-  // over the rows below the ground-plane prior's horizon, README "Real frames") or paper.
+  // Proposal features 10, 12, 13 (PipelineParams::box_features): ground_plane (ours; column
+  // offset, width and height over the rows below the ground-plane prior's horizon, README "Real
+  // frames") or paper.
   std::string box_size_features = "ground_plane";
   std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
   std::string sed_model;                     // model file for edge_source "sed"

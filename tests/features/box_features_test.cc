@@ -252,8 +252,9 @@ TEST(BoxFeaturesTest, RegionOriginOffsetAndClipping) {
   EXPECT_NEAR(f[12], 3.0 / 40.0, kTol);
 }
 
-// With a horizon, features 12-13 are the box's width and height over its centre's rows below it,
-// so the same physical size gives the same values at any distance; nothing else changes.
+// With a horizon, features 10, 12 and 13 are the centre's offset from the middle column, the width
+// and the height over the centre's rows below it: the same physical position and size give the
+// same values at any distance. Nothing else changes.
 TEST(BoxFeaturesTest, GroundPlaneSizeDividesByTheRowsBelowTheHorizon) {
   const cv::Point origin(10, 20);
   const cv::Size image(40, 50);
@@ -263,10 +264,11 @@ TEST(BoxFeaturesTest, GroundPlaneSizeDividesByTheRowsBelowTheHorizon) {
   // Centre row 20 + 2 = 22, 10 rows below the horizon.
   const BoxFeatureVector p = paper.Compute({15, 20, 3, 4}, 0.f);
   const BoxFeatureVector g = ground.Compute({15, 20, 3, 4}, 0.f);
+  EXPECT_NEAR(g[10], (16.5 - 20.0) / 10.0, kTol);  // left of the middle column 20
   EXPECT_NEAR(g[12], 3.0 / 10.0, kTol);
   EXPECT_NEAR(g[13], 4.0 / 10.0, kTol);
   for (int i = 0; i < kNumBoxFeatures; ++i) {
-    if (i != 12 && i != 13) {
+    if (i != 10 && i != 12 && i != 13) {
       EXPECT_FLOAT_EQ(g[i], p[i]) << "feature " << i;
     }
   }
@@ -279,6 +281,7 @@ TEST(BoxFeaturesTest, GroundPlaneSizeDividesByTheRowsBelowTheHorizon) {
   const BoxFeatureExtractor above(ThreeBoundaryMap(), Uniform(8, 8, {0, 0, 255}), origin, image,
                                   {.horizon_y = 40.0});
   const BoxFeatureVector a = above.Compute({15, 20, 3, 4}, 0.f);
+  EXPECT_FLOAT_EQ(a[10], -3.5f);
   EXPECT_FLOAT_EQ(a[12], 3.f);
   EXPECT_FLOAT_EQ(a[13], 4.f);
 }
