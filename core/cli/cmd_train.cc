@@ -88,6 +88,10 @@ Runner AddTrainCommand(CLI::App& app) {
                   "proposal features 10, 12, 13: ground_plane (column offset, width and height "
                   "over the rows below a fitted horizon, default) or paper (over the image's size)")
       ->check(CLI::IsMember({"paper", "ground_plane"}));
+  cmd->add_option("--occlusion-size-features", args->train.occlusion_size_features,
+                  "occlusion classifier's boundary length, region areas and vertical order: "
+                  "paper (pixels, default) or ground_plane (over the rows below a fitted horizon)")
+      ->check(CLI::IsMember({"paper", "ground_plane"}));
   bool* correct = &args->train.prior_correction;
   cmd->add_flag_callback(
       "--no-prior-correction", [correct] { *correct = false; },

@@ -152,7 +152,7 @@ Result<OcclusionSamples> ExtractOcclusionSamples(const OcclusionTrainingFrame& f
     return Status::InvalidArgument(what + ": labels size differs from the image size");
   }
   const SuperpixelPairs pairs =
-      ComputeSuperpixelPairs(frame.image, frame.enhanced_edge, frame.superpixels);
+      ComputeSuperpixelPairs(frame.image, frame.enhanced_edge, frame.superpixels, frame.features);
   const std::vector<RegionTruth> truths =
       RegionTruths(frame.superpixels.labels, frame.superpixels.count, frame.labels);
   OcclusionSamples out;
@@ -267,11 +267,12 @@ std::vector<float> PairProbabilities(const RandomForest& forest, const cv::Mat1f
 }  // namespace
 
 Result<cv::Mat1f> OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                                             const Superpixels& superpixels) const {
+                                             const Superpixels& superpixels,
+                                             const OcclusionFeatureOptions& features) const {
   if (Status s = ValidateMaps(image, enhanced_edge, superpixels, "occlusion paint"); !s.ok()) {
     return s;
   }
-  const SuperpixelPairs pairs = ComputeSuperpixelPairs(image, enhanced_edge, superpixels);
+  const SuperpixelPairs pairs = ComputeSuperpixelPairs(image, enhanced_edge, superpixels, features);
   std::vector<float> strength;
   if (trained()) {
     strength = PairProbabilities(forest_, pairs.features);

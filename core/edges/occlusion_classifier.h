@@ -10,6 +10,7 @@
 
 #include "core/base/binary_io.h"
 #include "core/base/status.h"
+#include "core/edges/occlusion_features.h"
 #include "core/edges/sticky_superpixels.h"
 #include "core/forest/random_forest.h"
 
@@ -32,7 +33,8 @@ struct OcclusionTrainingFrame {
   cv::Mat3b image;          // R1 crop
   cv::Mat1f enhanced_edge;  // Ê on the crop
   Superpixels superpixels;
-  cv::Mat1i labels;  // -1 ignore, 0 background, 1 road, >= 2 obstacle instance
+  cv::Mat1i labels;                  // -1 ignore, 0 background, 1 road, >= 2 obstacle instance
+  OcclusionFeatureOptions features;  // as Paint will be given them
 };
 
 // Training pairs of one or more frames (rows of kNumOcclusionFeatures floats), with the number of
@@ -69,8 +71,10 @@ class OcclusionClassifier {
 
   // Occlusion edge map on the crop: boundary pixels carry the max pair probability (>= floor),
   // all other pixels 0. Inputs that disagree in size or labels out of range are an error.
+  // `features` must measure sizes as the training frames' did (PipelineParams records it).
   Result<cv::Mat1f> Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                          const Superpixels& superpixels) const;
+                          const Superpixels& superpixels,
+                          const OcclusionFeatureOptions& features) const;
 
   // The file format is in occlusion_classifier.cc; Load's errors name the reader's source.
   Status Save(BinaryWriter& out) const;

@@ -104,7 +104,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     plain_params.prior_correction.occlusion_odds = 1.0;  // mean E is no classifier probability
     const Result<OcclusionEdges> plain_computed =
         ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &untrained_boundaries,
-                              plain_params, /*enhance=*/false);
+                              OcclusionFeatureOptions{}, plain_params, /*enhance=*/false);
     if (!plain_computed.ok()) return plain_computed.status();
     const OcclusionEdges& plain = *plain_computed;
     const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1, kMaxProposals);
@@ -115,8 +115,9 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     // The detector's own path (timed): enhanced edges, BP = OAOCC+OLP@4+MS, regression, map.
     StageTimer timer;
     const Result<OcclusionEdges> computed =
-        ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion, bundle.params,
-                              /*enhance=*/true, &timer);
+        ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion,
+                              OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows),
+                              bundle.params, /*enhance=*/true, &timer);
     if (!computed.ok()) return computed.status();
     const OcclusionEdges& oaocc = *computed;
     const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;

@@ -46,13 +46,31 @@ FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height)
   return g;
 }
 
-BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height) {
-  BoxFeatureOptions options;
-  const BoxFeatureParams& params = bundle.params.box_features;
-  if (!params.ground_plane_size) return options;
+namespace {
+
+// A training-frame row of the bundle on a frame of width x height.
+double MappedRow(const ModelBundle& bundle, int width, int height, double row) {
   const MultilayerRegions& trained = bundle.regions;
   const FrameMapping m = MappingForFrame(trained.image_width, trained.image_height, width, height);
-  options.horizon_y = params.horizon_y * m.scale + m.dy;
+  return row * m.scale + m.dy;
+}
+
+}  // namespace
+
+BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height) {
+  BoxFeatureOptions options;
+  const GroundPlaneFeatureParams& params = bundle.params.box_features;
+  if (params.ground_plane_size)
+    options.horizon_y = MappedRow(bundle, width, height, params.horizon_y);
+  return options;
+}
+
+OcclusionFeatureOptions OcclusionFeatureOptionsForFrame(const ModelBundle& bundle, int width,
+                                                        int height) {
+  OcclusionFeatureOptions options;
+  const GroundPlaneFeatureParams& params = bundle.params.occlusion_features;
+  if (params.ground_plane_size)
+    options.horizon_y = MappedRow(bundle, width, height, params.horizon_y);
   return options;
 }
 

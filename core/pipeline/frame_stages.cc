@@ -16,12 +16,10 @@ namespace tod {
 
 using Clock = std::chrono::steady_clock;
 
-Result<OcclusionEdges> ComputeOcclusionEdges(const cv::Mat3b& image,
-                                             const MultilayerRegions& regions,
-                                             const EdgeSource& edges,
-                                             const OcclusionClassifier* classifier,
-                                             const PipelineParams& params, bool enhance,
-                                             StageTimer* timer) {
+Result<OcclusionEdges> ComputeOcclusionEdges(
+    const cv::Mat3b& image, const MultilayerRegions& regions, const EdgeSource& edges,
+    const OcclusionClassifier* classifier, const OcclusionFeatureOptions& occlusion_features,
+    const PipelineParams& params, bool enhance, StageTimer* timer) {
   // Marks a stage boundary; true when the timer's check asks to stop here.
   auto mark = [timer](const char* stage) {
     if (timer != nullptr) timer->Mark(stage);
@@ -50,7 +48,10 @@ Result<OcclusionEdges> ComputeOcclusionEdges(const cv::Mat3b& image,
   out.superpixels = std::move(superpixels).value();
   if (mark("superpixels")) return out;
   if (classifier != nullptr) {
-    Result<cv::Mat1f> occlusion = classifier->Paint(out.crop, out.enhanced, out.superpixels);
+    OcclusionFeatureOptions features = occlusion_features;
+    features.crop_y = out.r1.y;
+    Result<cv::Mat1f> occlusion =
+        classifier->Paint(out.crop, out.enhanced, out.superpixels, features);
     if (!occlusion.ok()) return occlusion.status();
     out.occlusion = std::move(occlusion).value();
     CorrectSampledPrior(out.occlusion, params.prior_correction.occlusion_odds);

@@ -30,14 +30,13 @@ struct OcclusionEdges {
 
 // enhance = false gives the plain (non obstacle-aware) variant used by the OLP baseline.
 // With a null classifier only E, Ê and the superpixels are computed (training of the classifier).
+// `occlusion_features` are the classifier's (OcclusionFeatureOptionsForFrame; crop_y is set here).
 // When the timer asks to stop at a stage boundary the maps computed so far are returned and the
 // caller reads timer->stopped(); a stage that rejects its input is an error naming the stage.
-Result<OcclusionEdges> ComputeOcclusionEdges(const cv::Mat3b& image,
-                                             const MultilayerRegions& regions,
-                                             const EdgeSource& edges,
-                                             const OcclusionClassifier* classifier,
-                                             const PipelineParams& params, bool enhance,
-                                             StageTimer* timer = nullptr);
+Result<OcclusionEdges> ComputeOcclusionEdges(
+    const cv::Mat3b& image, const MultilayerRegions& regions, const EdgeSource& edges,
+    const OcclusionClassifier* classifier, const OcclusionFeatureOptions& occlusion_features,
+    const PipelineParams& params, bool enhance, StageTimer* timer = nullptr);
 
 // Region k's occlusion edge map (un-normalised): the R1 map cropped to R_k, with the artificial
 // frame edges along the crop border removed for k >= 2 (§3.2(4)). k is 0-based here.

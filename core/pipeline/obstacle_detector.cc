@@ -81,6 +81,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
   const Result<OcclusionEdges> computed =
       ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges, &bundle_.occlusion,
+                            OcclusionFeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows),
                             bundle_.params, /*enhance=*/true, &timer);
   if (!computed.ok()) return computed.status();
   if (!timer.stopped().ok()) return timer.stopped();

@@ -28,12 +28,13 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PriorCorrection, edge_odds, occl
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeScreening, trees, final_at_most)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ObstacleCalibration, fitted, slope, intercept,
                                                 samples, positives)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BoxFeatureParams, ground_plane_size, horizon_y)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GroundPlaneFeatureParams, ground_plane_size,
+                                                horizon_y)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradient_edges,
                                                 superpixels, boxes, multistride, size_filter,
                                                 region_merge_iou, prior_correction, edge_screening,
                                                 obstacle_calibration, fusion, probability_map,
-                                                box_features)
+                                                box_features, occlusion_features)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
 
@@ -62,12 +63,12 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
       !(p.prior_correction.edge_odds > 0) || !(p.prior_correction.occlusion_odds > 0) ||
       p.edge_screening.trees < 0 ||
       !(p.edge_screening.final_at_most >= 0 && p.edge_screening.final_at_most < 1) ||
-      !std::isfinite(p.box_features.horizon_y))
+      !std::isfinite(p.box_features.horizon_y) || !std::isfinite(p.occlusion_features.horizon_y))
     return Status::InvalidArgument(
         "parameters out of range (regions.num_layers, superpixels.k, fusion.keep_ratio, "
         "probability_map.top_fraction, region_merge_iou in (0, 1], prior_correction > 0, "
         "edge_screening.trees >= 0, edge_screening.final_at_most in [0, 1), "
-        "box_features.horizon_y finite)");
+        "box_features.horizon_y and occlusion_features.horizon_y finite)");
   return p;
 }
 

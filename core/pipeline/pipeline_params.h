@@ -27,17 +27,20 @@ struct PriorCorrection {
   double occlusion_odds = 1.0;  // c of the occlusion classifier
 };
 
-// Features 10, 12 and 13 of a proposal (§5: centre column, width and height over the image's).
-// With few training frames the regressors see obstacles at a few distances only, and a box's
-// pixel size and column then say "as far as the training obstacles stood": a near obstacle,
-// larger than any they saw, is scored like the large boxes of road and background (README, "Real
-// frames", point 11). On a flat road image lengths are physical lengths times the distance below
-// the horizon (the ground-plane size prior fits that horizon), so with ground_plane_size the
-// features are (centre column − middle column) / d, w / d and h / d, d = box centre row −
-// horizon_y (at least 1 px): a lateral position and a size that every training obstacle informs
-// at every distance. horizon_y is in the training frame's pixels (frame_geometry.h maps it to
-// other frame sizes). Off: the paper's features.
-struct BoxFeatureParams {
+// Sizes measured on the ground plane (ours; README "Real frames", points 11 and 12). With few
+// training frames the learned parts see obstacles at a few distances only, and a size in pixels
+// then says "as far as the training obstacles stood": a near obstacle, larger than any they saw,
+// looks like the large patches of road and background. On a flat road image lengths are
+// physical lengths times the distance below the horizon (the ground-plane size prior fits that
+// horizon), so with ground_plane_size a length is divided by d = row − horizon_y (at least 1 px)
+// and an area by d². horizon_y is in the training frame's pixels (frame_geometry.h maps it to
+// other frame sizes). Off: the paper's pixel sizes.
+//  - box_features: proposal features 10, 12 and 13 (§5: centre column, width and height over the
+//    image's) become (centre column − middle column) / d, w / d and h / d, d from the box's
+//    centre row: a lateral position and a size that every training obstacle informs.
+//  - occlusion_features: the occlusion classifier's boundary length, region areas and vertical
+//    order (occlusion_features.h), d from the boundary's mean row.
+struct GroundPlaneFeatureParams {
   bool ground_plane_size = false;
   double horizon_y = 0.0;
 };
@@ -76,7 +79,8 @@ struct PipelineParams {
   ObstacleCalibration obstacle_calibration;  // fitted by `tod train`
   FusionParams fusion;
   ProbabilityMapParams probability_map;
-  BoxFeatureParams box_features;
+  GroundPlaneFeatureParams box_features;
+  GroundPlaneFeatureParams occlusion_features;
 };
 
 nlohmann::json ToJson(const PipelineParams& params);

@@ -8,6 +8,7 @@
 #include "core/base/memory_usage.h"
 #include "core/edges/edge_labels.h"
 #include "core/pipeline/dataset_factory.h"
+#include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/parallel.h"
@@ -170,32 +171,42 @@ Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, ModelBundle& bun
   return Status::Ok();
 }
 
-// With ground-plane size features (PipelineParams::box_features), their horizon: the one the
-// ground-plane size prior fits to the training obstacles, whatever the size filter's recipe.
-Status PlaceFeatureHorizon(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
-                           nlohmann::json& parts) {
-  const std::string& choice = run.options().box_size_features;
+// With ground-plane sizes (PipelineParams::box_features, occlusion_features), their horizon: the
+// one the ground-plane size prior fits to the training obstacles, whatever the size filter's
+// recipe. `choice` is the option's value, `flag` its name, `part` the manifest key.
+Status PlaceGroundPlaneHorizon(TrainingRun& run, const Survey& survey, const std::string& choice,
+                               const std::string& flag, const std::string& part,
+                               GroundPlaneFeatureParams& params, nlohmann::json& parts) {
   if (choice != "ground_plane" && choice != "paper")
-    return Status::InvalidArgument("--box-size-features must be ground_plane or paper, got '" +
-                                   choice + "'");
-  BoxFeatureParams& features = bundle.params.box_features;
-  features.ground_plane_size = choice == "ground_plane";
-  if (!features.ground_plane_size) {
-    parts["box_features"] = {{"size", "paper"}};
+    return Status::InvalidArgument(flag + " must be ground_plane or paper, got '" + choice + "'");
+  params.ground_plane_size = choice == "ground_plane";
+  if (!params.ground_plane_size) {
+    parts[part] = {{"size", "paper"}};
     return Status::Ok();
   }
   const auto prior = FitGroundPlaneSizePrior(survey.obstacle_boxes);
   if (!prior.ok())
-    return prior.status().WithContext(
-        "placing the horizon of the ground-plane size features (too few obstacles? "
-        "--box-size-features paper needs none)");
-  features.horizon_y = prior->horizon_y;
-  parts["box_features"] = {{"size", "ground_plane"}, {"horizon_y", features.horizon_y}};
-  char line[96];
-  std::snprintf(line, sizeof line, "box features 10, 12, 13: x/d, w/d, h/d below row %.1f",
-                features.horizon_y);
-  run.Say(line);
+    return prior.status().WithContext("placing the horizon of the ground-plane " + part +
+                                      " (too few obstacles? " + flag + " paper needs none)");
+  params.horizon_y = prior->horizon_y;
+  parts[part] = {{"size", "ground_plane"}, {"horizon_y", params.horizon_y}};
+  char line[64];
+  std::snprintf(line, sizeof line, ": sizes over the rows below row %.1f", params.horizon_y);
+  run.Say(part + line);
   return Status::Ok();
+}
+
+Status PlaceFeatureHorizons(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
+                            nlohmann::json& parts) {
+  const TrainOptions& options = run.options();
+  if (Status st =
+          PlaceGroundPlaneHorizon(run, survey, options.box_size_features, "--box-size-features",
+                                  "box_features", bundle.params.box_features, parts);
+      !st.ok())
+    return st;
+  return PlaceGroundPlaneHorizon(run, survey, options.occlusion_size_features,
+                                 "--occlusion-size-features", "occlusion_features",
+                                 bundle.params.occlusion_features, parts);
 }
 
 // Multilayer regions and the size filter from the training obstacles (§1.4, §4.3).
@@ -222,7 +233,7 @@ Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundl
                                    "'");
   }
   bundle.size_filter.enabled = options.params.size_filter;
-  if (Status st = PlaceFeatureHorizon(run, survey, bundle, parts); !st.ok()) return st;
+  if (Status st = PlaceFeatureHorizons(run, survey, bundle, parts); !st.ok()) return st;
   for (int k = 0; k < bundle.regions.num_layers(); ++k) {
     const Box& r = bundle.regions.layers[k];
     char line[96];  // snprintf: GCC 12 warns (-Wrestrict, falsely) on "R" + std::to_string
@@ -392,11 +403,14 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
   const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
     const ModelBundle& upstream = folds.For(bundle, i);
     const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-        s.image, bundle.regions, *upstream.edges, nullptr, upstream.params, /*enhance=*/true);
+        s.image, bundle.regions, *upstream.edges, nullptr, {}, upstream.params, /*enhance=*/true);
     if (!computed.ok()) return computed.status();
     const OcclusionEdges& oaocc = *computed;
+    OcclusionFeatureOptions features =
+        OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows);
+    features.crop_y = oaocc.r1.y;
     const OcclusionTrainingFrame frame{oaocc.crop, oaocc.enhanced, oaocc.superpixels,
-                                       LabelMap(s)(oaocc.r1.rect()).clone()};
+                                       LabelMap(s)(oaocc.r1.rect()).clone(), features};
     auto samples = ExtractOcclusionSamples(frame, params, static_cast<std::size_t>(i));
     if (!samples.ok()) return samples.status();
     per_frame[i] = std::move(*samples);
@@ -476,7 +490,9 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
         if (cv::countNonZero(s.road) > 0) {
           const ModelBundle& upstream = folds.For(bundle, i);
           const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-              s.image, bundle.regions, *upstream.edges, &upstream.occlusion, upstream.params, true);
+              s.image, bundle.regions, *upstream.edges, &upstream.occlusion,
+              OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), upstream.params,
+              true);
           if (!computed.ok()) return computed.status();
           const OcclusionEdges& oaocc = *computed;
           const ProposalSet all =

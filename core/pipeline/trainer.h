@@ -37,6 +37,10 @@ struct TrainOptions {
   // offset, width and height over the rows below the ground-plane prior's horizon, README "Real
   // frames") or paper.
   std::string box_size_features = "ground_plane";
+  // The occlusion classifier's boundary length, region areas and vertical order
+  // (PipelineParams::occlusion_features): ground_plane (ours; over the rows below the same
+  // horizon) or paper (pixels).
+  std::string occlusion_size_features = "paper";
   std::string edge_source = "pixel_forest";  // pixel_forest | gradient | sed
   std::string sed_model;                     // model file for edge_source "sed"
   std::uint64_t seed = 1;

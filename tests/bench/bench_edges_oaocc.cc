@@ -112,8 +112,9 @@ int main() {
     const double sp_ms = MedianMs(kRuns, [&] {
       sp = std::move(tod::ComputeStickySuperpixels(scene.image, edge, sp_params)).value();
     });
-    const double fb_ms = MedianMs(kRuns, [&] { (void)fallback.Paint(scene.image, edge, sp); });
-    const double forest_ms = MedianMs(kRuns, [&] { (void)trained.Paint(scene.image, edge, sp); });
+    const double fb_ms = MedianMs(kRuns, [&] { (void)fallback.Paint(scene.image, edge, sp, {}); });
+    const double forest_ms =
+        MedianMs(kRuns, [&] { (void)trained.Paint(scene.image, edge, sp, {}); });
     std::printf("%-8d %-14d %10.1f %14.1f %18.1f %16d\n", k, sp.count, sp_ms, fb_ms, forest_ms,
                 cv::countNonZero(sp.labels == 0));
   }

@@ -186,33 +186,39 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   }
 }
 
-// --box-size-features chooses features 10, 12 and 13: the manifest keeps the choice and the horizon
-// it divides by (the ground-plane prior's), and an unknown choice is refused before any work.
-TEST_F(MasksCliTest, BoxSizeFeaturesAreAChoiceAndRecorded) {
-  for (const std::string choice : {"paper", "ground_plane"}) {
-    const std::string model = (out_ / ("size_" + choice)).string();
-    const CommandResult run = RunCommand(Train(model, "--box-size-features " + choice));
-    ASSERT_EQ(run.exit_code, 0) << run.output;
-    const nlohmann::json manifest = Manifest(model);
-    const bool ground = choice == "ground_plane";
-    EXPECT_EQ(manifest["params"]["box_features"]["ground_plane_size"], ground);
-    EXPECT_EQ(manifest["training"]["parts"]["box_features"]["size"], choice);
-    if (ground) {
-      EXPECT_EQ(manifest["params"]["box_features"]["horizon_y"],
-                manifest["training"]["parts"]["size_filter"]["horizon_y"]);
-      EXPECT_NE(run.output.find("box features 10, 12, 13"), std::string::npos) << run.output;
+// --box-size-features (proposal features 10, 12, 13) and --occlusion-size-features (the
+// occlusion classifier's sizes) each choose pixels or the ground plane: the manifest keeps the
+// choice and the horizon it divides by (the ground-plane prior's), the bundle runs, and an
+// unknown choice is refused before any work.
+TEST_F(MasksCliTest, GroundPlaneFeaturesAreAChoiceAndRecorded) {
+  for (const std::string part : {"box", "occlusion"}) {
+    const std::string flag = "--" + part + "-size-features";
+    const std::string key = part + "_features";
+    for (const std::string choice : {"paper", "ground_plane"}) {
+      const std::string model = (out_ / (part + "_" + choice)).string();
+      const CommandResult run = RunCommand(Train(model, flag + " " + choice));
+      ASSERT_EQ(run.exit_code, 0) << run.output;
+      const nlohmann::json manifest = Manifest(model);
+      const bool ground = choice == "ground_plane";
+      EXPECT_EQ(manifest["params"][key]["ground_plane_size"], ground) << flag;
+      EXPECT_EQ(manifest["training"]["parts"][key]["size"], choice) << flag;
+      if (ground) {
+        EXPECT_EQ(manifest["params"][key]["horizon_y"],
+                  manifest["training"]["parts"]["size_filter"]["horizon_y"]);
+        EXPECT_NE(run.output.find(key + ": sizes over the rows below row"), std::string::npos)
+            << run.output;
+      }
+      // The bundle runs: detect reads the choice back from the manifest.
+      const CommandResult detect = RunCommand(tod_ + " detect --model " + model + " --out " +
+                                              (out_ / ("detect_" + part + choice)).string() + " " +
+                                              (*root_ / "images" / "2.png").string());
+      EXPECT_EQ(detect.exit_code, 0) << detect.output;
     }
-    // The bundle runs: detect reads the choice back from the manifest.
-    const CommandResult detect = RunCommand(tod_ + " detect --model " + model + " --out " +
-                                            (out_ / ("detect_" + choice)).string() + " " +
-                                            (*root_ / "images" / "2.png").string());
-    EXPECT_EQ(detect.exit_code, 0) << detect.output;
+    const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), flag + " metres"));
+    EXPECT_NE(wrong.exit_code, 0);
+    EXPECT_NE(wrong.output.find(flag.substr(2)), std::string::npos) << wrong.output;
+    EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
   }
-  const CommandResult wrong =
-      RunCommand(Train((out_ / "wrong").string(), "--box-size-features metres"));
-  EXPECT_NE(wrong.exit_code, 0);
-  EXPECT_NE(wrong.output.find("box-size-features"), std::string::npos) << wrong.output;
-  EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
 }
 
 // --size-filter-recipe bands restores the authors' per-band extremes (three bands); the manifest
