@@ -97,7 +97,7 @@ int main() {
     f.labels = small.labels;
     frames.push_back(f);
   }
-  tod::OcclusionParams params;  // 200 trees, the default
+  tod::OcclusionParams params;  // 400 trees, the default
   params.forest.threads = 1;
   const OcclusionClassifier trained = std::move(OcclusionClassifier::Fit(frames, params)).value();
   const OcclusionClassifier fallback;

@@ -95,7 +95,7 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
     EXPECT_EQ(manifest["training"]["parts"][part]["trained"], true) << part;
   EXPECT_EQ(manifest["training"]["parts"]["ordr"]["hard_negatives"], "mined");
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 16);
-  EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 200);
+  EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 400);
   EXPECT_EQ(manifest["params"]["edge_screening"]["trees"], 0);  // off: every tree on every cell
   const nlohmann::json& size_filter = manifest["training"]["parts"]["size_filter"];
   EXPECT_EQ(size_filter["recipe"], "ground_plane") << size_filter.dump();
