@@ -14,11 +14,17 @@ FrameBudget::Clock::time_point At(FrameBudget::Clock::time_point start, double m
 }  // namespace
 
 FrameBudget::FrameBudget(Clock::time_point start, double budget_ms,
-                         const FrameBudgetParams& params) {
-  if (!(budget_ms > 0)) return;
-  limited_ = true;
-  proposals_deadline_ = At(start, budget_ms * std::clamp(params.proposals_end, 0.0, 1.0));
-  regression_deadline_ = At(start, budget_ms * std::clamp(params.regression_end, 0.0, 1.0));
+                         const FrameBudgetParams& params)
+    : params_(params) {
+  if (budget_ms > 0) end_ = At(start, budget_ms);
+}
+
+FrameBudget::Clock::time_point FrameBudget::ProposalsDeadline() const {
+  return ShareOfRemaining(end_, std::clamp(params_.proposals_share, 0.0, 1.0), 1.0);
+}
+
+FrameBudget::Clock::time_point FrameBudget::RegressionDeadline() const {
+  return ShareOfRemaining(end_, std::clamp(params_.regression_share, 0.0, 1.0), 1.0);
 }
 
 double BudgetLeftMs(double budget_ms, double spent_ms) {

@@ -91,7 +91,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   // RSS over 20 real frames rose 190 -> 199 MB although the live heap's peak fell.
   ProposalOptions proposal_options =
       DetectorProposalOptions(bundle_.params, geometry.regions.num_layers());
-  proposal_options.deadline = budget.proposals_deadline();
+  proposal_options.deadline = budget.ProposalsDeadline();
   proposal_options.threads = threads;
   ProposalSet proposals = ProposeBoxes(oaocc, geometry.regions, bundle_.params.boxes,
                                        proposal_options, geometry.size_filter);
@@ -101,7 +101,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   if (!proposals.truncated_regions.empty()) out.degraded_stages.push_back("proposals");
   RegressedProposals regressed =
       RegressProposals(bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer,
-                       {.deadline = budget.regression_deadline(), .threads = threads});
+                       {.deadline = budget.RegressionDeadline(), .threads = threads});
   if (!timer.stopped().ok()) return timer.stopped();
   if (regressed.truncated) out.degraded_stages.push_back("regression");
   const std::vector<float> fused =

@@ -20,18 +20,41 @@ using Clock = std::chrono::steady_clock;
 TEST(FrameBudgetTest, NoBudgetHasNoDeadlines) {
   const FrameBudget none;
   EXPECT_FALSE(none.limited());
-  EXPECT_EQ(none.proposals_deadline(), Clock::time_point::max());
+  EXPECT_EQ(none.ProposalsDeadline(), Clock::time_point::max());
   const FrameBudget zero(Clock::now(), 0);
   EXPECT_FALSE(zero.limited());
-  EXPECT_EQ(zero.regression_deadline(), Clock::time_point::max());
+  EXPECT_EQ(zero.RegressionDeadline(), Clock::time_point::max());
 }
 
-TEST(FrameBudgetTest, StageDeadlinesAreTheirSharesOfTheBudget) {
-  const Clock::time_point start = Clock::now();
-  const FrameBudget budget(start, 1000, {.proposals_end = 0.5, .regression_end = 0.8});
-  ASSERT_TRUE(budget.limited());
-  EXPECT_EQ(budget.proposals_deadline() - start, std::chrono::milliseconds(500));
-  EXPECT_EQ(budget.regression_deadline() - start, std::chrono::milliseconds(800));
+// Each stage gets its share of the time left when it asks, so time the whole stages before it
+// took is not charged to it twice (fixed points of the budget cut the proposals of every real
+// frame on a machine where the stages before them took half the budget).
+TEST(FrameBudgetTest, StageDeadlinesAreTheirSharesOfTheTimeLeft) {
+  using std::chrono::hours;
+  using std::chrono::minutes;
+  using std::chrono::seconds;
+  constexpr double kHourMs = 3'600'000;
+  const FrameBudgetParams shares{.proposals_share = 0.5, .regression_share = 0.75};
+  // A fresh hour: the proposals may use half of it, the regression three quarters.
+  Clock::time_point before = Clock::now();
+  const FrameBudget fresh(before, kHourMs, shares);
+  ASSERT_TRUE(fresh.limited());
+  EXPECT_EQ(fresh.end() - before, hours(1));
+  EXPECT_GE(fresh.ProposalsDeadline() - before, minutes(30));
+  EXPECT_LE(fresh.ProposalsDeadline() - before, minutes(30) + seconds(1));
+  EXPECT_GE(fresh.RegressionDeadline() - before, minutes(45));
+  EXPECT_LE(fresh.RegressionDeadline() - before, minutes(45) + seconds(1));
+  // 40 minutes already spent: the shares are of the 20 left.
+  before = Clock::now();
+  const FrameBudget spent(before - minutes(40), kHourMs, shares);
+  EXPECT_GE(spent.ProposalsDeadline() - before, minutes(10));
+  EXPECT_LE(spent.ProposalsDeadline() - before, minutes(10) + seconds(1));
+  EXPECT_GE(spent.RegressionDeadline() - before, minutes(15));
+  EXPECT_LE(spent.RegressionDeadline() - before, minutes(15) + seconds(1));
+  // All spent: the deadlines are the budget's end, already past.
+  const FrameBudget over(Clock::now() - hours(2), kHourMs, shares);
+  EXPECT_EQ(over.ProposalsDeadline(), over.end());
+  EXPECT_EQ(over.RegressionDeadline(), over.end());
 }
 
 TEST(FrameBudgetTest, ShareOfRemainingSplitsTheTimeLeftByWeight) {
