@@ -80,7 +80,8 @@ ServerMetrics::ServerMetrics()
   // Every reason from the start, so dashboards and alerts see 0 rather than no series.
   for (const CancelReason reason : kAllCancelReasons)
     cancelled_.Add({{"reason", CancelReasonName(reason)}});
-  for (const char* stage : {"proposals", "regression"}) degraded_.Add({{"stage", stage}});
+  for (const char* stage : {"occlusion", "proposals", "regression"})
+    degraded_.Add({{"stage", stage}});
 }
 
 void ServerMetrics::RecordRequest(const std::string& protocol, const std::string& code,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <opencv2/core/utility.hpp>
@@ -246,21 +247,45 @@ namespace {
 // pieces much smaller than this would walk the trees more often than they gain.
 constexpr int kMinPairsPerPiece = 2048;
 
-// The forest's probability for every pair (row of `features`), in contiguous pieces on OpenCV's
-// threads (as many as `--threads-per-request` allows; one piece on one thread). Each row's sum
-// is the same whichever piece walks it, so the result does not depend on the thread count.
-std::vector<float> PairProbabilities(const RandomForest& forest, const cv::Mat1f& features) {
+// The forest's probability for every pair (row of `features`). The trees are walked piece by
+// piece (OcclusionClassifier::Paint), and each piece of trees over contiguous pieces of rows on
+// OpenCV's threads (as many as `--threads-per-request` allows; one piece on one thread). Each
+// row's sum is the same whichever piece of rows walks it, and the pieces of trees add in tree
+// order, so the result depends neither on the thread count nor on the deadline's checks.
+struct PairStrength {
+  std::vector<float> probability;
+  int trees = 0;  // trees walked for every pair
+};
+
+PairStrength PairProbabilities(const RandomForest& forest, const cv::Mat1f& features,
+                               std::chrono::steady_clock::time_point deadline) {
   const int rows = features.rows;
-  const int pieces = std::clamp(rows / kMinPairsPerPiece, 1, std::max(1, cv::getNumThreads()));
-  if (pieces == 1) return forest.PredictBatch(features);
-  std::vector<float> out(static_cast<std::size_t>(rows));
-  cv::parallel_for_(cv::Range(0, pieces), [&](const cv::Range& range) {
-    for (int p = range.start; p < range.end; ++p) {
-      const int begin = rows * p / pieces, end = rows * (p + 1) / pieces;
-      const std::vector<float> part = forest.PredictBatch(features.rowRange(begin, end));
-      std::copy(part.begin(), part.end(), out.begin() + begin);
+  const int row_pieces = std::clamp(rows / kMinPairsPerPiece, 1, std::max(1, cv::getNumThreads()));
+  const int trees = forest.num_trees();
+  const int trees_per_piece = std::max(1, (trees + OcclusionClassifier::kOcclusionTreePieces - 1) /
+                                              OcclusionClassifier::kOcclusionTreePieces);
+  std::vector<double> sums(static_cast<std::size_t>(rows), 0.0);
+  PairStrength out;
+  while (out.trees < trees) {
+    const int first = out.trees, last = std::min(trees, first + trees_per_piece);
+    const auto walk_rows = [&](int p) {
+      const int begin = rows * p / row_pieces, end = rows * (p + 1) / row_pieces;
+      forest.AccumulateTreeRange(features.rowRange(begin, end), first, last, sums.data() + begin);
+    };
+    if (row_pieces == 1) {
+      walk_rows(0);
+    } else {
+      cv::parallel_for_(cv::Range(0, row_pieces), [&](const cv::Range& range) {
+        for (int p = range.start; p < range.end; ++p) walk_rows(p);
+      });
     }
-  });
+    out.trees = last;
+    if (std::chrono::steady_clock::now() >= deadline) break;
+  }
+  out.probability.resize(sums.size());
+  const auto walked = static_cast<double>(std::max(1, out.trees));
+  for (std::size_t r = 0; r < sums.size(); ++r)
+    out.probability[r] = static_cast<float>(sums[r] / walked);
   return out;
 }
 
@@ -268,14 +293,19 @@ std::vector<float> PairProbabilities(const RandomForest& forest, const cv::Mat1f
 
 Result<cv::Mat1f> OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
                                              const Superpixels& superpixels,
-                                             const OcclusionFeatureOptions& features) const {
+                                             const OcclusionFeatureOptions& features,
+                                             std::chrono::steady_clock::time_point deadline,
+                                             int* trees_walked) const {
   if (Status s = ValidateMaps(image, enhanced_edge, superpixels, "occlusion paint"); !s.ok()) {
     return s;
   }
   const SuperpixelPairs pairs = ComputeSuperpixelPairs(image, enhanced_edge, superpixels, features);
   std::vector<float> strength;
+  if (trees_walked != nullptr) *trees_walked = 0;
   if (trained()) {
-    strength = PairProbabilities(forest_, pairs.features);
+    PairStrength walked = PairProbabilities(forest_, pairs.features, deadline);
+    strength = std::move(walked.probability);
+    if (trees_walked != nullptr) *trees_walked = walked.trees;
   } else {
     // Fallback (§3.4): mean Ê along the shared boundary, rescaled to [0,1] per image.
     strength.resize(pairs.pairs.size());

@@ -4,6 +4,7 @@
 // The untrained fallback scores a boundary by its mean Ê, rescaled to [0,1] per image.
 #pragma once
 
+#include <chrono>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -65,6 +66,7 @@ class OcclusionClassifier {
   static Result<OcclusionClassifier> FitOnSamples(OcclusionSamples samples,
                                                   const OcclusionParams& params);
   bool trained() const { return !forest_.empty(); }
+  int num_trees() const { return forest_.num_trees(); }
   const OcclusionParams& params() const { return params_; }
   // Of the last Fit: (share of negative pairs kept) / (share of positive pairs kept), the odds
   // factor that undoes the class balancing (PriorCorrection); 1 when nothing was dropped. Not
@@ -74,9 +76,18 @@ class OcclusionClassifier {
   // Occlusion edge map on the crop: boundary pixels carry the max pair probability (>= floor),
   // all other pixels 0. Inputs that disagree in size or labels out of range are an error.
   // `features` must measure sizes as the training frames' did (PipelineParams records it).
-  Result<cv::Mat1f> Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                          const Superpixels& superpixels,
-                          const OcclusionFeatureOptions& features) const;
+  // Under a deadline (the frame budget), the forest is walked for all pairs a piece of trees at
+  // a time (kOcclusionTreePieces pieces) and no piece after the first starts past `deadline`:
+  // a pair's probability is then the mean of the trees walked, the same estimate from fewer
+  // trees, for every pair alike. *trees_walked (when given) says how many; with every tree the
+  // map is bit-identical to the one without a deadline.
+  Result<cv::Mat1f> Paint(
+      const cv::Mat3b& image, const cv::Mat1f& enhanced_edge, const Superpixels& superpixels,
+      const OcclusionFeatureOptions& features,
+      std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max(),
+      int* trees_walked = nullptr) const;
+  // Trees of the forest walked between two deadline checks: 1 / kOcclusionTreePieces of them.
+  static constexpr int kOcclusionTreePieces = 16;
 
   // The file format is in occlusion_classifier.cc; Load's errors name the reader's source.
   Status Save(BinaryWriter& out) const;

@@ -212,6 +212,15 @@ void RandomForest::PredictRows(const float* const* rows, int count, float* out) 
   for (int r = 0; r < count; ++r) out[r] = static_cast<float>(sums[r] / trees);
 }
 
+void RandomForest::AccumulateTreeRange(const cv::Mat1f& features, int tree_begin, int tree_end,
+                                       double* sums) const {
+  if (features.rows <= 0 || features.cols != num_features_) return;
+  std::vector<const float*> rows(static_cast<std::size_t>(features.rows));
+  for (int r = 0; r < features.rows; ++r) rows[r] = features[r];
+  AccumulateTrees(rows.data(), features.rows, std::max(tree_begin, 0),
+                  std::min(tree_end, num_trees()), sums);
+}
+
 std::vector<float> RandomForest::PredictBatchScreened(const cv::Mat1f& features, int screen_trees,
                                                       float final_at_most) const {
   if (screen_trees <= 0 || screen_trees >= num_trees()) return PredictBatch(features);

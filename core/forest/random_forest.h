@@ -55,6 +55,14 @@ class RandomForest {
   std::vector<float> PredictBatchScreened(const cv::Mat1f& features, int screen_trees,
                                           float final_at_most) const;
 
+  // The walk in pieces of trees: adds, for every row of `features`, the outputs of trees
+  // [tree_begin, tree_end) (clamped to the forest) to sums[row], in tree order. Calls over
+  // consecutive ranges from 0 to num_trees() leave in sums what PredictBatch divides by
+  // num_trees(), bit for bit. A caller that must stop early (a frame budget) stops between
+  // ranges. Does nothing when features.cols != num_features().
+  void AccumulateTreeRange(const cv::Mat1f& features, int tree_begin, int tree_end,
+                           double* sums) const;
+
   int num_features() const { return num_features_; }
   int num_trees() const { return static_cast<int>(tree_roots_.size()); }
   bool empty() const { return tree_roots_.empty(); }

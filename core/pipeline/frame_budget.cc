@@ -13,10 +13,13 @@ FrameBudget::Clock::time_point At(FrameBudget::Clock::time_point start, double m
 
 }  // namespace
 
-FrameBudget::FrameBudget(Clock::time_point start, double budget_ms,
-                         const FrameBudgetParams& params)
+FrameBudget::FrameBudget(Clock::time_point start, double budget_ms, const FrameBudgetParams& params)
     : params_(params) {
   if (budget_ms > 0) end_ = At(start, budget_ms);
+}
+
+FrameBudget::Clock::time_point FrameBudget::OcclusionDeadline() const {
+  return ShareOfRemaining(end_, std::clamp(params_.occlusion_share, 0.0, 1.0), 1.0);
 }
 
 FrameBudget::Clock::time_point FrameBudget::ProposalsDeadline() const {

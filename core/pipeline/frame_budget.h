@@ -1,7 +1,10 @@
 // The time one frame may take (issue 11, `--frame-budget-ms`), and how the stages share it.
-// Edges, superpixels and the occlusion map cost what the frame's pixels cost (bounded by the
-// pixel limit) and always run whole; the two stages whose cost grows with the frame's content
-// degrade when their share runs out, in a defined way:
+// Edges and superpixels cost what the frame's pixels cost (bounded by the pixel limit) and
+// always run whole; the three stages whose cost grows with the frame's content degrade when
+// their share runs out, in a defined way:
+//  - occlusion: the classifier's forest is walked for all superpixel pairs a piece of trees at a
+//    time (OcclusionClassifier::Paint) and stops between pieces: every pair's probability is
+//    the mean of fewer trees (a frame of many small superpixels has many pairs);
 //  - proposals: the window scan of each region stops handing out grid columns at the region's
 //    deadline (the columns left out are scattered over shapes and positions: a coarser grid);
 //    the far regions, scanned last, lose windows first (a request with several threads scans
@@ -17,13 +20,15 @@
 namespace tod {
 
 struct FrameBudgetParams {
-  // The shares of the time left when a stage starts that the proposals, then the features +
-  // ORDR, may use. The rest is left for OBDR on the gated boxes, the map and its encoding (a few
-  // tens of ms on 2 MP frames). Shares of the time left, not fixed points of the budget: the
-  // whole stages before them (decode, edges, superpixels, occlusion) take what the machine
-  // makes them take, and fixed points (proposals by 55 % of the budget, regression by 85 %)
-  // cut the proposals of every real frame on a machine where those stages took 1000 of the
-  // 2000 ms (README, Frame budget).
+  // The shares of the time left when a stage starts that the occlusion classifier's forest,
+  // the proposals, then the features + ORDR, may use. The rest is left for OBDR on the gated
+  // boxes, the map and its encoding (a few tens of ms on 2 MP frames). Shares of the time left,
+  // not fixed points of the budget: the whole stages before them (decode, edges, superpixels)
+  // take what the machine makes them take, and fixed points (proposals by 55 % of the budget,
+  // regression by 85 %) cut the proposals of every real frame on a machine where the stages
+  // before them took 1000 of the 2000 ms (README, Frame budget). A real frame's occlusion
+  // stage needs about a quarter of the time left after the superpixels.
+  double occlusion_share = 0.35;
   double proposals_share = 0.5;
   double regression_share = 0.75;
 };
@@ -40,6 +45,7 @@ class FrameBudget {
   Clock::time_point end() const { return end_; }
   // Asked when the stage starts: now + its share of the time left until end() (end() itself
   // when that has passed); Clock::time_point::max() without a budget.
+  Clock::time_point OcclusionDeadline() const;
   Clock::time_point ProposalsDeadline() const;
   Clock::time_point RegressionDeadline() const;
 

@@ -19,7 +19,7 @@ using Clock = std::chrono::steady_clock;
 Result<OcclusionEdges> ComputeOcclusionEdges(
     const cv::Mat3b& image, const MultilayerRegions& regions, const EdgeSource& edges,
     const OcclusionClassifier* classifier, const OcclusionFeatureOptions& occlusion_features,
-    const PipelineParams& params, bool enhance, StageTimer* timer) {
+    const PipelineParams& params, bool enhance, StageTimer* timer, const FrameBudget* budget) {
   // Marks a stage boundary; true when the timer's check asks to stop here.
   auto mark = [timer](const char* stage) {
     if (timer != nullptr) timer->Mark(stage);
@@ -50,10 +50,13 @@ Result<OcclusionEdges> ComputeOcclusionEdges(
   if (classifier != nullptr) {
     OcclusionFeatureOptions features = occlusion_features;
     features.crop_y = out.r1.y;
-    Result<cv::Mat1f> occlusion =
-        classifier->Paint(out.crop, out.enhanced, out.superpixels, features);
+    const Clock::time_point deadline =
+        budget != nullptr ? budget->OcclusionDeadline() : Clock::time_point::max();
+    Result<cv::Mat1f> occlusion = classifier->Paint(out.crop, out.enhanced, out.superpixels,
+                                                    features, deadline, &out.occlusion_trees);
     if (!occlusion.ok()) return occlusion.status();
     out.occlusion = std::move(occlusion).value();
+    out.occlusion_cut_short = out.occlusion_trees < classifier->num_trees();
     CorrectSampledPrior(out.occlusion, params.prior_correction.occlusion_odds);
     (void)mark("occlusion");  // the caller checks timer->stopped() after the last stage
   }

@@ -10,6 +10,7 @@
 #include "core/edges/edge_source.h"
 #include "core/edges/occlusion_classifier.h"
 #include "core/edges/sticky_superpixels.h"
+#include "core/pipeline/frame_budget.h"
 #include "core/pipeline/multilayer_regions.h"
 #include "core/pipeline/pipeline_params.h"
 #include "core/pipeline/proposal_features.h"
@@ -26,6 +27,10 @@ struct OcclusionEdges {
   cv::Mat1f enhanced;   // Ê = n(p) E(p)
   Superpixels superpixels;
   cv::Mat1f occlusion;  // occlusion edge map on the crop
+  // Trees of the occlusion classifier walked for every pair: fewer than it has when the frame
+  // budget cut the stage short (occlusion_cut_short).
+  int occlusion_trees = 0;
+  bool occlusion_cut_short = false;
 };
 
 // enhance = false gives the plain (non obstacle-aware) variant used by the OLP baseline.
@@ -33,10 +38,13 @@ struct OcclusionEdges {
 // `occlusion_features` are the classifier's (OcclusionFeatureOptionsForFrame; crop_y is set here).
 // When the timer asks to stop at a stage boundary the maps computed so far are returned and the
 // caller reads timer->stopped(); a stage that rejects its input is an error naming the stage.
+// With a frame budget the occlusion classifier walks its trees until the budget's
+// OcclusionDeadline (asked when the stage starts).
 Result<OcclusionEdges> ComputeOcclusionEdges(
     const cv::Mat3b& image, const MultilayerRegions& regions, const EdgeSource& edges,
     const OcclusionClassifier* classifier, const OcclusionFeatureOptions& occlusion_features,
-    const PipelineParams& params, bool enhance, StageTimer* timer = nullptr);
+    const PipelineParams& params, bool enhance, StageTimer* timer = nullptr,
+    const FrameBudget* budget = nullptr);
 
 // Region k's occlusion edge map (un-normalised): the R1 map cropped to R_k, with the artificial
 // frame edges along the crop border removed for k >= 2 (§3.2(4)). k is 0-based here.

@@ -82,7 +82,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   const Result<OcclusionEdges> computed =
       ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges, &bundle_.occlusion,
                             OcclusionFeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows),
-                            bundle_.params, /*enhance=*/true, &timer);
+                            bundle_.params, /*enhance=*/true, &timer, &budget);
   if (!computed.ok()) return computed.status();
   if (!timer.stopped().ok()) return timer.stopped();
   const OcclusionEdges& oaocc = *computed;
@@ -98,6 +98,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   timer.Mark("proposals");
   if (!timer.stopped().ok()) return timer.stopped();
   Detection out;
+  if (oaocc.occlusion_cut_short) out.degraded_stages.push_back("occlusion");
   if (!proposals.truncated_regions.empty()) out.degraded_stages.push_back("proposals");
   RegressedProposals regressed =
       RegressProposals(bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer,

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <opencv2/imgproc.hpp>
@@ -467,6 +468,35 @@ TEST_F(TrainedOcclusionTest, PaintIsTheSameOnOneThreadAndOnSeveral) {
   ASSERT_EQ(three.size(), image.size());
   EXPECT_EQ(cv::countNonZero(one != three), 0);
   EXPECT_GT(cv::countNonZero(one > SmallForest().floor), 1000);  // the forest painted them
+}
+
+// Under a frame budget the forest stops between pieces of trees: with the deadline never reached
+// the map is the one without a deadline, bit for bit; with it already past, only the first
+// piece (20 trees / 16 pieces -> 2 trees) is walked, every pair alike, and the map is the
+// same estimate from fewer trees: a valid map that still tells contours from texture.
+TEST_F(TrainedOcclusionTest, PaintStopsBetweenPiecesOfTreesAtItsDeadline) {
+  using Clock = std::chrono::steady_clock;
+  const SyntheticFrame test = MakeFrame(99);
+  const OcclusionTrainingFrame& f = test.frame;
+  const cv::Mat1f full = Painted(*classifier_, f.image, f.enhanced_edge, f.superpixels);
+  int walked = -1;
+  const Result<cv::Mat1f> unreached = classifier_->Paint(
+      f.image, f.enhanced_edge, f.superpixels, {}, Clock::now() + std::chrono::hours(1), &walked);
+  ASSERT_TRUE(unreached.ok());
+  EXPECT_EQ(walked, classifier_->num_trees());
+  EXPECT_EQ(cv::countNonZero(*unreached != full), 0);
+
+  const Result<cv::Mat1f> past = classifier_->Paint(
+      f.image, f.enhanced_edge, f.superpixels, {}, Clock::now() - std::chrono::seconds(1), &walked);
+  ASSERT_TRUE(past.ok());
+  ASSERT_EQ(classifier_->num_trees(), 20);
+  EXPECT_EQ(walked, 2);
+  const cv::Mat1b boundary = f.superpixels.labels == 0;
+  EXPECT_EQ(cv::countNonZero((*past != 0) != boundary), 0);
+  EXPECT_GT(cv::countNonZero((*past != full) & boundary), 0);
+  const double object = MeanOver(*past, test.object_contour, f.superpixels.labels);
+  const double texture = MeanOver(*past, test.texture_contour, f.superpixels.labels);
+  EXPECT_GT(object, texture + 0.1) << "object " << object << " texture " << texture;
 }
 
 TEST_F(TrainedOcclusionTest, PaintOnlyOnBoundariesAndAtLeastFloor) {

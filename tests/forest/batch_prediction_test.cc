@@ -184,6 +184,31 @@ TEST(BatchPrediction, ManyBlocksMatchPredictBitForBit) {
   for (std::size_t k = 0; k < subset.size(); ++k) EXPECT_EQ(some[k], batch[subset[k]]) << k;
 }
 
+// The walk in pieces of trees (what a frame budget stops between): consecutive ranges add up to
+// PredictBatch's sums bit for bit; ranges are clamped to the forest; a wrong width adds nothing.
+TEST(BatchPrediction, TreeRangesAddUpToPredictBatchBitForBit) {
+  const RandomForest forest = DeepForest();
+  const Data test = MakeData(3000, 3, 34);
+  std::vector<double> sums(3000, 0.0);
+  forest.AccumulateTreeRange(test.x, -4, 5, sums.data());
+  forest.AccumulateTreeRange(test.x, 5, 5, sums.data());  // empty
+  forest.AccumulateTreeRange(test.x, 5, 99, sums.data());
+  const std::vector<float> batch = forest.PredictBatch(test.x);
+  int mismatches = 0;
+  for (int r = 0; r < test.x.rows; ++r)
+    mismatches += static_cast<float>(sums[r] / forest.num_trees()) != batch[r];
+  EXPECT_EQ(mismatches, 0);
+  // The first trees alone: their mean, as the screened walk stops at it.
+  std::vector<double> first(3000, 0.0);
+  forest.AccumulateTreeRange(test.x, 0, 4, first.data());
+  const std::vector<float> screened = forest.PredictBatchScreened(test.x, 4, 1e9f);
+  for (int r = 0; r < test.x.rows; ++r)
+    ASSERT_EQ(static_cast<float>(first[r] / 4.0), screened[r]) << r;
+  std::vector<double> untouched(3000, 0.0);
+  forest.AccumulateTreeRange(MakeData(3000, 4, 35).x, 0, 12, untouched.data());
+  EXPECT_EQ(untouched, std::vector<double>(3000, 0.0));
+}
+
 TEST(BatchPrediction, RowsMayBeAViewIntoAWiderMatrix) {
   const RandomForest forest = DeepForest();
   const Data wide = MakeData(50, 7, 33);

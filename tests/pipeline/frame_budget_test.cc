@@ -111,7 +111,7 @@ TEST_F(DetectBudgetTest, AGenerousBudgetChangesNothing) {
   EXPECT_EQ(cv::norm(with->probability, without->probability, cv::NORM_INF), 0.0);
 }
 
-// A budget far below what the fixed stages take: every region's scan deadline has passed before
+// A budget far below what the whole stages take: every region's scan deadline has passed before
 // it starts, so no window is scored. The frame still gets a valid (empty) answer that says so.
 TEST_F(DetectBudgetTest, AnExhaustedBudgetDegradesTheProposalsAndSaysSo) {
   DetectOptions options;
@@ -124,6 +124,12 @@ TEST_F(DetectBudgetTest, AnExhaustedBudgetDegradesTheProposalsAndSaysSo) {
       detection->degraded_stages.end());
   EXPECT_TRUE(detection->proposals.empty());
   EXPECT_EQ(detection->probability.size(), frame_.size());
+  // This bundle's occlusion map is the untrained mean-Ê fallback (no trees to cut short), so
+  // the occlusion stage is not said to be degraded; a trained one is (BenchCliTest).
+  ASSERT_FALSE(detector_->bundle().occlusion.trained());
+  EXPECT_EQ(
+      std::find(detection->degraded_stages.begin(), detection->degraded_stages.end(), "occlusion"),
+      detection->degraded_stages.end());
 }
 
 // The regression deadline alone: proposals are complete, none is regressed.
