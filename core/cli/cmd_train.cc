@@ -71,6 +71,14 @@ Runner AddTrainCommand(CLI::App& app) {
                   "occlusion classifier: negative superpixel pairs kept per obstacle-contour "
                   "pair")
       ->check(CLI::Range(1, 1000));
+  cmd->add_option("--occlusion-screen-trees", args->train.params.occlusion_screening.trees,
+                  "occlusion classifier's early exit: a superpixel pair whose mean over its "
+                  "first N trees is at most --occlusion-screen-below keeps that mean (0 = off, "
+                  "the default)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--occlusion-screen-below", args->train.params.occlusion_screening.final_at_most,
+                  "the early exit's bound on the first trees' mean probability")
+      ->check(CLI::Range(0.0, 0.999));
   cmd->add_option("--superpixel-strips", args->train.params.superpixels.strip_rows,
                   "sweep the sticky superpixels in strips of N rows, side by side on a "
                   "request's threads (0 = raster order, one thread: the default)")

@@ -21,10 +21,7 @@ namespace tod {
 // keeps that mean; every other cell gets the whole forest, exactly as without screening.
 // trees = 0: every tree on every cell (the reference). Sources that are not tree ensembles
 // ignore it. The pipeline takes it from PipelineParams::edge_screening.
-struct EdgeScreening {
-  int trees = 0;
-  float final_at_most = 0.f;
-};
+using EdgeScreening = ForestScreening;
 
 class EdgeSource {
  public:

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <opencv2/core/utility.hpp>
 #include <random>
 #include <string_view>
@@ -251,41 +252,72 @@ constexpr int kMinPairsPerPiece = 2048;
 // piece (OcclusionClassifier::Paint), and each piece of trees over contiguous pieces of rows on
 // OpenCV's threads (as many as `--threads-per-request` allows; one piece on one thread). Each
 // row's sum is the same whichever piece of rows walks it, and the pieces of trees add in tree
-// order, so the result depends neither on the thread count nor on the deadline's checks.
+// order, so the result depends neither on the thread count nor on the deadline's checks. With
+// screening the first piece is the screening trees, after which the rows at or under the bound
+// keep their mean and only the others go on (PredictBatchScreened's values, bit for bit).
 struct PairStrength {
   std::vector<float> probability;
-  int trees = 0;  // trees walked for every pair
+  int trees = 0;  // trees walked for every pair that went on
 };
 
+// Adds trees [first, last) to sums[r] for every row of `rows`, in pieces of rows on the threads.
+void WalkTreePiece(const RandomForest& forest, const cv::Mat1f& rows, int first, int last,
+                   std::vector<double>& sums) {
+  const int count = rows.rows;
+  const int row_pieces = std::clamp(count / kMinPairsPerPiece, 1, std::max(1, cv::getNumThreads()));
+  const auto walk_rows = [&](int p) {
+    const int begin = count * p / row_pieces, end = count * (p + 1) / row_pieces;
+    forest.AccumulateTreeRange(rows.rowRange(begin, end), first, last, sums.data() + begin);
+  };
+  if (row_pieces == 1) return walk_rows(0);
+  cv::parallel_for_(cv::Range(0, row_pieces), [&](const cv::Range& range) {
+    for (int p = range.start; p < range.end; ++p) walk_rows(p);
+  });
+}
+
 PairStrength PairProbabilities(const RandomForest& forest, const cv::Mat1f& features,
-                               std::chrono::steady_clock::time_point deadline) {
-  const int rows = features.rows;
-  const int row_pieces = std::clamp(rows / kMinPairsPerPiece, 1, std::max(1, cv::getNumThreads()));
+                               const OcclusionPaintOptions& options) {
   const int trees = forest.num_trees();
   const int trees_per_piece = std::max(1, (trees + OcclusionClassifier::kOcclusionTreePieces - 1) /
                                               OcclusionClassifier::kOcclusionTreePieces);
-  std::vector<double> sums(static_cast<std::size_t>(rows), 0.0);
+  const bool screened = options.screening.trees > 0 && options.screening.trees < trees;
   PairStrength out;
+  out.probability.assign(static_cast<std::size_t>(features.rows), 0.f);
+  // The rows still walked, their sums and their indices in `features`.
+  cv::Mat1f rows = features;
+  std::vector<double> sums(static_cast<std::size_t>(features.rows), 0.0);
+  std::vector<int> index(sums.size());
+  std::iota(index.begin(), index.end(), 0);
   while (out.trees < trees) {
-    const int first = out.trees, last = std::min(trees, first + trees_per_piece);
-    const auto walk_rows = [&](int p) {
-      const int begin = rows * p / row_pieces, end = rows * (p + 1) / row_pieces;
-      forest.AccumulateTreeRange(features.rowRange(begin, end), first, last, sums.data() + begin);
-    };
-    if (row_pieces == 1) {
-      walk_rows(0);
-    } else {
-      cv::parallel_for_(cv::Range(0, row_pieces), [&](const cv::Range& range) {
-        for (int p = range.start; p < range.end; ++p) walk_rows(p);
-      });
-    }
+    const int first = out.trees;
+    const int last =
+        std::min(trees, first == 0 && screened ? options.screening.trees : first + trees_per_piece);
+    WalkTreePiece(forest, rows, first, last, sums);
     out.trees = last;
-    if (std::chrono::steady_clock::now() >= deadline) break;
+    if (first == 0 && screened) {
+      // Rows at or under the bound stop with the screening trees' mean; the rest go on.
+      cv::Mat1f going_on(0, rows.cols);
+      std::vector<double> going_on_sums;
+      std::vector<int> going_on_index;
+      for (int r = 0; r < rows.rows; ++r) {
+        const float mean = static_cast<float>(sums[r] / static_cast<double>(last));
+        if (mean <= options.screening.final_at_most) {
+          out.probability[index[r]] = mean;
+        } else {
+          going_on.push_back(rows.row(r));
+          going_on_sums.push_back(sums[r]);
+          going_on_index.push_back(index[r]);
+        }
+      }
+      rows = going_on;
+      sums = std::move(going_on_sums);
+      index = std::move(going_on_index);
+    }
+    if (std::chrono::steady_clock::now() >= options.deadline) break;
   }
-  out.probability.resize(sums.size());
   const auto walked = static_cast<double>(std::max(1, out.trees));
-  for (std::size_t r = 0; r < sums.size(); ++r)
-    out.probability[r] = static_cast<float>(sums[r] / walked);
+  for (std::size_t k = 0; k < index.size(); ++k)
+    out.probability[index[k]] = static_cast<float>(sums[k] / walked);
   return out;
 }
 
@@ -293,17 +325,17 @@ PairStrength PairProbabilities(const RandomForest& forest, const cv::Mat1f& feat
 
 Result<cv::Mat1f> OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
                                              const Superpixels& superpixels,
-                                             const OcclusionFeatureOptions& features,
-                                             std::chrono::steady_clock::time_point deadline,
+                                             const OcclusionPaintOptions& options,
                                              int* trees_walked) const {
   if (Status s = ValidateMaps(image, enhanced_edge, superpixels, "occlusion paint"); !s.ok()) {
     return s;
   }
-  const SuperpixelPairs pairs = ComputeSuperpixelPairs(image, enhanced_edge, superpixels, features);
+  const SuperpixelPairs pairs =
+      ComputeSuperpixelPairs(image, enhanced_edge, superpixels, options.features);
   std::vector<float> strength;
   if (trees_walked != nullptr) *trees_walked = 0;
   if (trained()) {
-    PairStrength walked = PairProbabilities(forest_, pairs.features, deadline);
+    PairStrength walked = PairProbabilities(forest_, pairs.features, options);
     strength = std::move(walked.probability);
     if (trees_walked != nullptr) *trees_walked = walked.trees;
   } else {

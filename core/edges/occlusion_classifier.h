@@ -32,6 +32,16 @@ struct OcclusionParams {
   int negatives_per_positive = 4;
 };
 
+// How Paint measures and walks the pairs of one frame.
+struct OcclusionPaintOptions {
+  // Must measure sizes as the training frames' did (PipelineParams::occlusion_features).
+  OcclusionFeatureOptions features;
+  // Early exit (PipelineParams::occlusion_screening; off by default): a pair whose mean over the
+  // first trees is at most the bound keeps that mean (RandomForest::PredictBatchScreened).
+  ForestScreening screening;
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+};
+
 struct OcclusionTrainingFrame {
   cv::Mat3b image;          // R1 crop
   cv::Mat1f enhanced_edge;  // Ê on the crop
@@ -66,6 +76,8 @@ class OcclusionClassifier {
   static Result<OcclusionClassifier> FitOnSamples(OcclusionSamples samples,
                                                   const OcclusionParams& params);
   bool trained() const { return !forest_.empty(); }
+  // The trained forest (empty when untrained): for tests that compare Paint with its reference.
+  const RandomForest& forest() const { return forest_; }
   int num_trees() const { return forest_.num_trees(); }
   const OcclusionParams& params() const { return params_; }
   // Of the last Fit: (share of negative pairs kept) / (share of positive pairs kept), the odds
@@ -75,17 +87,14 @@ class OcclusionClassifier {
 
   // Occlusion edge map on the crop: boundary pixels carry the max pair probability (>= floor),
   // all other pixels 0. Inputs that disagree in size or labels out of range are an error.
-  // `features` must measure sizes as the training frames' did (PipelineParams records it).
-  // Under a deadline (the frame budget), the forest is walked for all pairs a piece of trees at
-  // a time (kOcclusionTreePieces pieces) and no piece after the first starts past `deadline`:
-  // a pair's probability is then the mean of the trees walked, the same estimate from fewer
-  // trees, for every pair alike. *trees_walked (when given) says how many; with every tree the
-  // map is bit-identical to the one without a deadline.
-  Result<cv::Mat1f> Paint(
-      const cv::Mat3b& image, const cv::Mat1f& enhanced_edge, const Superpixels& superpixels,
-      const OcclusionFeatureOptions& features,
-      std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max(),
-      int* trees_walked = nullptr) const;
+  // Under a deadline (the frame budget), the forest is walked a piece of trees at a time
+  // (kOcclusionTreePieces pieces) and no piece after the first starts past it: a pair's
+  // probability is then the mean of the trees walked, for every pair that went on alike.
+  // *trees_walked (when given) says how many trees those pairs got; with all of them (the
+  // deadline not reached) the map is bit-identical to the one without a deadline.
+  Result<cv::Mat1f> Paint(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
+                          const Superpixels& superpixels, const OcclusionPaintOptions& options,
+                          int* trees_walked = nullptr) const;
   // Trees of the forest walked between two deadline checks: 1 / kOcclusionTreePieces of them.
   static constexpr int kOcclusionTreePieces = 16;
 

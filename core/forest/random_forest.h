@@ -26,6 +26,15 @@ struct ForestParams {
   int threads = 0;  // 0 = hardware concurrency
 };
 
+// Early exit over a forest's trees in their stored order (PredictBatchScreened): a row whose
+// mean over the first `trees` trees is at most `final_at_most` keeps that mean; every other row
+// gets the whole forest, exactly as without screening. trees = 0: every tree on every row (the
+// reference).
+struct ForestScreening {
+  int trees = 0;
+  float final_at_most = 0.f;
+};
+
 class RandomForest {
  public:
   RandomForest() = default;

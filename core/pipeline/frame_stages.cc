@@ -50,10 +50,12 @@ Result<OcclusionEdges> ComputeOcclusionEdges(
   if (classifier != nullptr) {
     OcclusionFeatureOptions features = occlusion_features;
     features.crop_y = out.r1.y;
-    const Clock::time_point deadline =
-        budget != nullptr ? budget->OcclusionDeadline() : Clock::time_point::max();
-    Result<cv::Mat1f> occlusion = classifier->Paint(out.crop, out.enhanced, out.superpixels,
-                                                    features, deadline, &out.occlusion_trees);
+    const OcclusionPaintOptions paint{
+        .features = features,
+        .screening = params.occlusion_screening,
+        .deadline = budget != nullptr ? budget->OcclusionDeadline() : Clock::time_point::max()};
+    Result<cv::Mat1f> occlusion =
+        classifier->Paint(out.crop, out.enhanced, out.superpixels, paint, &out.occlusion_trees);
     if (!occlusion.ok()) return occlusion.status();
     out.occlusion = std::move(occlusion).value();
     out.occlusion_cut_short = out.occlusion_trees < classifier->num_trees();

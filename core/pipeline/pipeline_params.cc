@@ -25,7 +25,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FusionParams, beta1, keep_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score, nms_iou, max_boxes,
                                                 top_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PriorCorrection, edge_odds, occlusion_odds)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeScreening, trees, final_at_most)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ForestScreening, trees, final_at_most)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ObstacleCalibration, fitted, slope, intercept,
                                                 samples, positives)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GroundPlaneFeatureParams, ground_plane_size,
@@ -33,8 +33,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GroundPlaneFeatureParams, ground
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradient_edges,
                                                 superpixels, boxes, multistride, size_filter,
                                                 region_merge_iou, prior_correction, edge_screening,
-                                                obstacle_calibration, fusion, probability_map,
-                                                box_features, occlusion_features)
+                                                occlusion_screening, obstacle_calibration, fusion,
+                                                probability_map, box_features, occlusion_features)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
 
@@ -63,11 +63,13 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
       !(p.prior_correction.edge_odds > 0) || !(p.prior_correction.occlusion_odds > 0) ||
       p.edge_screening.trees < 0 ||
       !(p.edge_screening.final_at_most >= 0 && p.edge_screening.final_at_most < 1) ||
+      p.occlusion_screening.trees < 0 ||
+      !(p.occlusion_screening.final_at_most >= 0 && p.occlusion_screening.final_at_most < 1) ||
       !std::isfinite(p.box_features.horizon_y) || !std::isfinite(p.occlusion_features.horizon_y))
     return Status::InvalidArgument(
         "parameters out of range (regions.num_layers, superpixels.k, fusion.keep_ratio, "
         "probability_map.top_fraction, region_merge_iou in (0, 1], prior_correction > 0, "
-        "edge_screening.trees >= 0, edge_screening.final_at_most in [0, 1), "
+        "edge_screening / occlusion_screening: trees >= 0, final_at_most in [0, 1), "
         "box_features.horizon_y and occlusion_features.horizon_y finite)");
   return p;
 }

@@ -76,6 +76,10 @@ struct PipelineParams {
   // values, which the first trees alone leave noisier (README, "Real frames", point 9).
   // {0, 0}: every tree on every cell.
   EdgeScreening edge_screening;
+  // Early exit in the occlusion classifier (ours, off by default; OcclusionPaintOptions): a
+  // superpixel pair whose mean over the first `trees` trees is at most `final_at_most` keeps it
+  // (README, "Real frames"). {0, 0}: every tree on every pair.
+  ForestScreening occlusion_screening;
   ObstacleCalibration obstacle_calibration;  // fitted by `tod train`
   FusionParams fusion;
   ProbabilityMapParams probability_map;

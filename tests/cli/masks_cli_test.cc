@@ -97,6 +97,7 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 16);
   EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 400);
   EXPECT_EQ(manifest["params"]["edge_screening"]["trees"], 0);  // off: every tree on every cell
+  EXPECT_EQ(manifest["params"]["occlusion_screening"]["trees"], 0);  // off: every tree, every pair
   const nlohmann::json& size_filter = manifest["training"]["parts"]["size_filter"];
   EXPECT_EQ(size_filter["recipe"], "ground_plane") << size_filter.dump();
   EXPECT_TRUE(size_filter["horizon_y"].is_number()) << size_filter.dump();
@@ -155,17 +156,20 @@ TEST_F(MasksCliTest, HardNegativeMiningByDefaultOneRoundOnRequest) {
   EXPECT_TRUE(m["training"]["seconds"].contains("hard_negatives"));
 }
 
-// The classifiers' tree counts and the superpixels' sweep order are choices the manifest
-// records; out of range is refused before any work.
+// The classifiers' tree counts, the occlusion classifier's early exit and the superpixels'
+// sweep order are choices the manifest records; out of range is refused before any work.
 TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   const std::string model = (out_ / "trees").string();
   const CommandResult run = RunCommand(
       Train(model,
             "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2 --superpixel-strips 16 "
-            "--edge-negatives 3 --occlusion-negatives 6"));
+            "--edge-negatives 3 --occlusion-negatives 6 --occlusion-screen-trees 3 "
+            "--occlusion-screen-below 0.25"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json manifest = Manifest(model);
   EXPECT_EQ(manifest["params"]["superpixels"]["strip_rows"], 16);
+  EXPECT_EQ(manifest["params"]["occlusion_screening"]["trees"], 3);
+  EXPECT_FLOAT_EQ(manifest["params"]["occlusion_screening"]["final_at_most"].get<float>(), 0.25f);
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 4);
   EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 12);
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["negatives_per_positive"], 3.0);
@@ -175,8 +179,9 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
             nlohmann::json({34, 34, 34, 34}));
   EXPECT_EQ(manifest["training"]["parts"]["obdr"]["negatives_per_range"],
             nlohmann::json({50, 50, 50, 50}));
-  for (const char* flag : {"--edge-trees 0", "--negatives-scale 0", "--superpixel-strips -1",
-                           "--edge-negatives 0", "--occlusion-negatives 0"}) {
+  for (const char* flag :
+       {"--edge-trees 0", "--negatives-scale 0", "--superpixel-strips -1", "--edge-negatives 0",
+        "--occlusion-negatives 0", "--occlusion-screen-trees -1", "--occlusion-screen-below 1"}) {
     const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), flag));
     EXPECT_NE(wrong.exit_code, 0) << flag;
     EXPECT_NE(wrong.output.find(std::string(flag).substr(0, std::string(flag).find(' '))),

@@ -470,6 +470,12 @@ TEST_F(TrainedOcclusionTest, PaintIsTheSameOnOneThreadAndOnSeveral) {
   EXPECT_GT(cv::countNonZero(one > SmallForest().floor), 1000);  // the forest painted them
 }
 
+OcclusionPaintOptions WithDeadline(std::chrono::steady_clock::time_point deadline) {
+  OcclusionPaintOptions options;
+  options.deadline = deadline;
+  return options;
+}
+
 // Under a frame budget the forest stops between pieces of trees: with the deadline never reached
 // the map is the one without a deadline, bit for bit; with it already past, only the first
 // piece (20 trees / 16 pieces -> 2 trees) is walked, every pair alike, and the map is the
@@ -480,14 +486,16 @@ TEST_F(TrainedOcclusionTest, PaintStopsBetweenPiecesOfTreesAtItsDeadline) {
   const OcclusionTrainingFrame& f = test.frame;
   const cv::Mat1f full = Painted(*classifier_, f.image, f.enhanced_edge, f.superpixels);
   int walked = -1;
-  const Result<cv::Mat1f> unreached = classifier_->Paint(
-      f.image, f.enhanced_edge, f.superpixels, {}, Clock::now() + std::chrono::hours(1), &walked);
+  const Result<cv::Mat1f> unreached =
+      classifier_->Paint(f.image, f.enhanced_edge, f.superpixels,
+                         WithDeadline(Clock::now() + std::chrono::hours(1)), &walked);
   ASSERT_TRUE(unreached.ok());
   EXPECT_EQ(walked, classifier_->num_trees());
   EXPECT_EQ(cv::countNonZero(*unreached != full), 0);
 
-  const Result<cv::Mat1f> past = classifier_->Paint(
-      f.image, f.enhanced_edge, f.superpixels, {}, Clock::now() - std::chrono::seconds(1), &walked);
+  const Result<cv::Mat1f> past =
+      classifier_->Paint(f.image, f.enhanced_edge, f.superpixels,
+                         WithDeadline(Clock::now() - std::chrono::seconds(1)), &walked);
   ASSERT_TRUE(past.ok());
   ASSERT_EQ(classifier_->num_trees(), 20);
   EXPECT_EQ(walked, 2);
@@ -497,6 +505,41 @@ TEST_F(TrainedOcclusionTest, PaintStopsBetweenPiecesOfTreesAtItsDeadline) {
   const double object = MeanOver(*past, test.object_contour, f.superpixels.labels);
   const double texture = MeanOver(*past, test.texture_contour, f.superpixels.labels);
   EXPECT_GT(object, texture + 0.1) << "object " << object << " texture " << texture;
+}
+
+// The early exit against its reference: the map painted by hand from the pairs' screened forest
+// values (RandomForest::PredictBatchScreened, itself compared with the whole walk in
+// batch_prediction_test), pixel for pixel; and screening off is the plain map.
+TEST_F(TrainedOcclusionTest, ScreenedPaintIsTheMapOfTheScreenedPairValues) {
+  const SyntheticFrame test = MakeFrame(77);
+  const OcclusionTrainingFrame& f = test.frame;
+  const cv::Mat1f full = Painted(*classifier_, f.image, f.enhanced_edge, f.superpixels);
+  const ForestScreening screening{.trees = 5, .final_at_most = 0.2f};
+  int walked = 0;
+  OcclusionPaintOptions options;
+  options.screening = screening;
+  const Result<cv::Mat1f> screened =
+      classifier_->Paint(f.image, f.enhanced_edge, f.superpixels, options, &walked);
+  ASSERT_TRUE(screened.ok());
+  EXPECT_EQ(walked, classifier_->num_trees());
+  const SuperpixelPairs pairs = ComputeSuperpixelPairs(f.image, f.enhanced_edge, f.superpixels, {});
+  const std::vector<float> values = classifier_->forest().PredictBatchScreened(
+      pairs.features, screening.trees, screening.final_at_most);
+  cv::Mat1f by_hand(f.image.size(), 0.f);
+  by_hand.setTo(classifier_->params().floor, f.superpixels.labels == 0);
+  for (std::size_t i = 0; i < pairs.boundary_pixels.size(); ++i) {
+    float value = classifier_->params().floor;
+    for (int k = pairs.pixel_offsets[i]; k < pairs.pixel_offsets[i + 1]; ++k)
+      value = std::max(value, values[pairs.pixel_pairs[k]]);
+    by_hand.ptr<float>(0)[pairs.boundary_pixels[i]] = value;
+  }
+  EXPECT_EQ(cv::countNonZero(*screened != by_hand), 0);
+  EXPECT_GT(cv::countNonZero(*screened != full), 0);  // some pairs did stop early
+  options.screening.trees = 0;
+  const Result<cv::Mat1f> off =
+      classifier_->Paint(f.image, f.enhanced_edge, f.superpixels, options);
+  ASSERT_TRUE(off.ok());
+  EXPECT_EQ(cv::countNonZero(*off != full), 0);
 }
 
 TEST_F(TrainedOcclusionTest, PaintOnlyOnBoundariesAndAtLeastFloor) {

@@ -62,8 +62,10 @@ TEST(FrameStagesTest, OcclusionMapUsesTheFeatureHorizonAndTheCropRow) {
   ASSERT_TRUE(oaocc.ok()) << oaocc.status().ToString();
   ASSERT_GT(oaocc->r1.y, 0);
   const auto paint = [&](const OcclusionFeatureOptions& features) {
+    OcclusionPaintOptions options;
+    options.features = features;
     Result<cv::Mat1f> painted =
-        bundle.occlusion.Paint(oaocc->crop, oaocc->enhanced, oaocc->superpixels, features);
+        bundle.occlusion.Paint(oaocc->crop, oaocc->enhanced, oaocc->superpixels, options);
     EXPECT_TRUE(painted.ok()) << painted.status().ToString();
     cv::Mat1f map = std::move(painted).value();
     CorrectSampledPrior(map, bundle.params.prior_correction.occlusion_odds);
