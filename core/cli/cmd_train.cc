@@ -73,11 +73,11 @@ Runner AddTrainCommand(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--occlusion-screen-trees", args->train.params.occlusion_screening.trees,
                   "occlusion classifier's early exit: a superpixel pair whose mean over its "
-                  "first N trees is at most --occlusion-screen-below keeps that mean (0 = off, "
-                  "the default)")
+                  "first N trees is at most --occlusion-screen-below keeps that mean (0 = off; "
+                  "default 25)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--occlusion-screen-below", args->train.params.occlusion_screening.final_at_most,
-                  "the early exit's bound on the first trees' mean probability")
+                  "the early exit's bound on the first trees' mean probability (default 0.05)")
       ->check(CLI::Range(0.0, 0.999));
   cmd->add_option("--superpixel-strips", args->train.params.superpixels.strip_rows,
                   "sweep the sticky superpixels in strips of N rows, side by side on a "

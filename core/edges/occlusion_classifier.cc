@@ -275,6 +275,31 @@ void WalkTreePiece(const RandomForest& forest, const cv::Mat1f& rows, int first,
   });
 }
 
+// The rows a walk still goes on with: their features, sums so far and indices in the input.
+struct RowsGoingOn {
+  cv::Mat1f rows;
+  std::vector<double> sums;
+  std::vector<int> index;
+};
+
+// The screening step: rows whose mean over the first `trees` trees is at most `bound` stop with
+// it (written to probability); the others go on with their sums.
+RowsGoingOn StopRowsAtOrUnder(const RowsGoingOn& walked, int trees, float bound,
+                              std::vector<float>& probability) {
+  RowsGoingOn going_on{cv::Mat1f(0, walked.rows.cols), {}, {}};
+  for (int r = 0; r < walked.rows.rows; ++r) {
+    const float mean = static_cast<float>(walked.sums[r] / static_cast<double>(trees));
+    if (mean <= bound) {
+      probability[walked.index[r]] = mean;
+    } else {
+      going_on.rows.push_back(walked.rows.row(r));
+      going_on.sums.push_back(walked.sums[r]);
+      going_on.index.push_back(walked.index[r]);
+    }
+  }
+  return going_on;
+}
+
 PairStrength PairProbabilities(const RandomForest& forest, const cv::Mat1f& features,
                                const OcclusionPaintOptions& options) {
   const int trees = forest.num_trees();
@@ -283,41 +308,22 @@ PairStrength PairProbabilities(const RandomForest& forest, const cv::Mat1f& feat
   const bool screened = options.screening.trees > 0 && options.screening.trees < trees;
   PairStrength out;
   out.probability.assign(static_cast<std::size_t>(features.rows), 0.f);
-  // The rows still walked, their sums and their indices in `features`.
-  cv::Mat1f rows = features;
-  std::vector<double> sums(static_cast<std::size_t>(features.rows), 0.0);
-  std::vector<int> index(sums.size());
-  std::iota(index.begin(), index.end(), 0);
+  RowsGoingOn walk{features, std::vector<double>(static_cast<std::size_t>(features.rows), 0.0),
+                   std::vector<int>(static_cast<std::size_t>(features.rows))};
+  std::iota(walk.index.begin(), walk.index.end(), 0);
   while (out.trees < trees) {
     const int first = out.trees;
     const int last =
         std::min(trees, first == 0 && screened ? options.screening.trees : first + trees_per_piece);
-    WalkTreePiece(forest, rows, first, last, sums);
+    WalkTreePiece(forest, walk.rows, first, last, walk.sums);
     out.trees = last;
-    if (first == 0 && screened) {
-      // Rows at or under the bound stop with the screening trees' mean; the rest go on.
-      cv::Mat1f going_on(0, rows.cols);
-      std::vector<double> going_on_sums;
-      std::vector<int> going_on_index;
-      for (int r = 0; r < rows.rows; ++r) {
-        const float mean = static_cast<float>(sums[r] / static_cast<double>(last));
-        if (mean <= options.screening.final_at_most) {
-          out.probability[index[r]] = mean;
-        } else {
-          going_on.push_back(rows.row(r));
-          going_on_sums.push_back(sums[r]);
-          going_on_index.push_back(index[r]);
-        }
-      }
-      rows = going_on;
-      sums = std::move(going_on_sums);
-      index = std::move(going_on_index);
-    }
+    if (first == 0 && screened)
+      walk = StopRowsAtOrUnder(walk, last, options.screening.final_at_most, out.probability);
     if (std::chrono::steady_clock::now() >= options.deadline) break;
   }
   const auto walked = static_cast<double>(std::max(1, out.trees));
-  for (std::size_t k = 0; k < index.size(); ++k)
-    out.probability[index[k]] = static_cast<float>(sums[k] / walked);
+  for (std::size_t k = 0; k < walk.index.size(); ++k)
+    out.probability[walk.index[k]] = static_cast<float>(walk.sums[k] / walked);
   return out;
 }
 

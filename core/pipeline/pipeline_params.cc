@@ -74,4 +74,10 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
   return p;
 }
 
+PipelineParams TrainingDefaultParams() {
+  PipelineParams params;
+  params.occlusion_screening = {.trees = 25, .final_at_most = 0.05f};
+  return params;
+}
+
 }  // namespace tod

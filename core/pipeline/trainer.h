@@ -49,7 +49,9 @@ struct TrainOptions {
   int threads = 0;               // 0 = all cores
   bool prior_correction = true;  // undo the classifiers' balanced sampling (PriorCorrection)
   BadFramePolicy on_bad_frame = BadFramePolicy::kFail;
-  PipelineParams params;
+  // A new bundle's parameters: PipelineParams' own, with the occlusion classifier's early exit
+  // on (TrainingDefaultParams).
+  PipelineParams params = TrainingDefaultParams();
   PixelEdgeParams edge_params;
   OcclusionParams occlusion_params;
   ForestParams regressor{.num_trees = 200, .max_features = 6, .min_leaf_size = 5};

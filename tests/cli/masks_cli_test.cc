@@ -97,7 +97,9 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 16);
   EXPECT_EQ(manifest["training"]["parts"]["occlusion"]["trees"], 400);
   EXPECT_EQ(manifest["params"]["edge_screening"]["trees"], 0);  // off: every tree on every cell
-  EXPECT_EQ(manifest["params"]["occlusion_screening"]["trees"], 0);  // off: every tree, every pair
+  // The occlusion classifier's early exit, on in a new bundle: 25 trees, bound 0.05.
+  EXPECT_EQ(manifest["params"]["occlusion_screening"]["trees"], 25);
+  EXPECT_FLOAT_EQ(manifest["params"]["occlusion_screening"]["final_at_most"].get<float>(), 0.05f);
   const nlohmann::json& size_filter = manifest["training"]["parts"]["size_filter"];
   EXPECT_EQ(size_filter["recipe"], "ground_plane") << size_filter.dump();
   EXPECT_TRUE(size_filter["horizon_y"].is_number()) << size_filter.dump();
