@@ -160,13 +160,14 @@ cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr, const EdgeScreening
   const EdgeChannels channels = ComputeEdgeChannels(bgr, channel_params_);
   cv::Mat1f cell_map(channels.rows(), channels.cols());
   const PixelFeatureExtractor extractor(channels);
+  ForestWalkOptions walk;  // one thread: the rows are already shared out below
+  walk.screening = screening;
   cv::parallel_for_(cv::Range(0, channels.rows()), [&](const cv::Range& rows) {
     cv::Mat1f row_features;
     for (int i = rows.start; i < rows.end; ++i) {
       extractor.ExtractRow(i, &row_features);
       // One batch per row: the forest walks each tree over the whole row (cache-friendly).
-      const std::vector<float> predicted =
-          forest_.PredictBatchScreened(row_features, screening.trees, screening.final_at_most);
+      const std::vector<float> predicted = forest_.PredictBatchScreened(row_features, walk).values;
       std::copy(predicted.begin(), predicted.end(), cell_map.ptr<float>(i));
     }
   });

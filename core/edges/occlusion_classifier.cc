@@ -244,87 +244,19 @@ Result<OcclusionClassifier> OcclusionClassifier::Fit(
 
 namespace {
 
-// Pairs per piece of the forest walk: the batched walk goes over each tree once per piece, so
-// pieces much smaller than this would walk the trees more often than they gain.
-constexpr int kMinPairsPerPiece = 2048;
-
-// The forest's probability for every pair (row of `features`). The trees are walked piece by
-// piece (OcclusionClassifier::Paint), and each piece of trees over contiguous pieces of rows on
-// OpenCV's threads (as many as `--threads-per-request` allows; one piece on one thread). Each
-// row's sum is the same whichever piece of rows walks it, and the pieces of trees add in tree
-// order, so the result depends neither on the thread count nor on the deadline's checks. With
-// screening the first piece is the screening trees, after which the rows at or under the bound
-// keep their mean and only the others go on (PredictBatchScreened's values, bit for bit).
-struct PairStrength {
-  std::vector<float> probability;
-  int trees = 0;  // trees walked for every pair that went on
-};
-
-// Adds trees [first, last) to sums[r] for every row of `rows`, in pieces of rows on the threads.
-void WalkTreePiece(const RandomForest& forest, const cv::Mat1f& rows, int first, int last,
-                   std::vector<double>& sums) {
-  const int count = rows.rows;
-  const int row_pieces = std::clamp(count / kMinPairsPerPiece, 1, std::max(1, cv::getNumThreads()));
-  const auto walk_rows = [&](int p) {
-    const int begin = count * p / row_pieces, end = count * (p + 1) / row_pieces;
-    forest.AccumulateTreeRange(rows.rowRange(begin, end), first, last, sums.data() + begin);
-  };
-  if (row_pieces == 1) return walk_rows(0);
-  cv::parallel_for_(cv::Range(0, row_pieces), [&](const cv::Range& range) {
-    for (int p = range.start; p < range.end; ++p) walk_rows(p);
-  });
-}
-
-// The rows a walk still goes on with: their features, sums so far and indices in the input.
-struct RowsGoingOn {
-  cv::Mat1f rows;
-  std::vector<double> sums;
-  std::vector<int> index;
-};
-
-// The screening step: rows whose mean over the first `trees` trees is at most `bound` stop with
-// it (written to probability); the others go on with their sums.
-RowsGoingOn StopRowsAtOrUnder(const RowsGoingOn& walked, int trees, float bound,
-                              std::vector<float>& probability) {
-  RowsGoingOn going_on{cv::Mat1f(0, walked.rows.cols), {}, {}};
-  for (int r = 0; r < walked.rows.rows; ++r) {
-    const float mean = static_cast<float>(walked.sums[r] / static_cast<double>(trees));
-    if (mean <= bound) {
-      probability[walked.index[r]] = mean;
-    } else {
-      going_on.rows.push_back(walked.rows.row(r));
-      going_on.sums.push_back(walked.sums[r]);
-      going_on.index.push_back(walked.index[r]);
-    }
-  }
-  return going_on;
-}
-
-PairStrength PairProbabilities(const RandomForest& forest, const cv::Mat1f& features,
-                               const OcclusionPaintOptions& options) {
-  const int trees = forest.num_trees();
-  const int trees_per_piece = std::max(1, (trees + OcclusionClassifier::kOcclusionTreePieces - 1) /
-                                              OcclusionClassifier::kOcclusionTreePieces);
-  const bool screened = options.screening.trees > 0 && options.screening.trees < trees;
-  PairStrength out;
-  out.probability.assign(static_cast<std::size_t>(features.rows), 0.f);
-  RowsGoingOn walk{features, std::vector<double>(static_cast<std::size_t>(features.rows), 0.0),
-                   std::vector<int>(static_cast<std::size_t>(features.rows))};
-  std::iota(walk.index.begin(), walk.index.end(), 0);
-  while (out.trees < trees) {
-    const int first = out.trees;
-    const int last =
-        std::min(trees, first == 0 && screened ? options.screening.trees : first + trees_per_piece);
-    WalkTreePiece(forest, walk.rows, first, last, walk.sums);
-    out.trees = last;
-    if (first == 0 && screened)
-      walk = StopRowsAtOrUnder(walk, last, options.screening.final_at_most, out.probability);
-    if (std::chrono::steady_clock::now() >= options.deadline) break;
-  }
-  const auto walked = static_cast<double>(std::max(1, out.trees));
-  for (std::size_t k = 0; k < walk.index.size(); ++k)
-    out.probability[walk.index[k]] = static_cast<float>(walk.sums[k] / walked);
-  return out;
+// The forest's probability for every pair (row of `features`), walked in kOcclusionTreePieces
+// pieces of trees (OcclusionClassifier::Paint) on as many of OpenCV's threads as
+// `--threads-per-request` allows; the result depends neither on the thread count nor on the
+// deadline's checks unless the deadline stops the walk.
+ForestWalk PairProbabilities(const RandomForest& forest, const cv::Mat1f& features,
+                             const OcclusionPaintOptions& options) {
+  constexpr int kPieces = OcclusionClassifier::kOcclusionTreePieces;
+  ForestWalkOptions walk;
+  walk.screening = options.screening;
+  walk.trees_per_piece = std::max(1, (forest.num_trees() + kPieces - 1) / kPieces);
+  walk.deadline = options.deadline;
+  walk.threads = cv::getNumThreads();
+  return forest.PredictBatchScreened(features, walk);
 }
 
 }  // namespace
@@ -341,8 +273,8 @@ Result<cv::Mat1f> OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::M
   std::vector<float> strength;
   if (trees_walked != nullptr) *trees_walked = 0;
   if (trained()) {
-    PairStrength walked = PairProbabilities(forest_, pairs.features, options);
-    strength = std::move(walked.probability);
+    ForestWalk walked = PairProbabilities(forest_, pairs.features, options);
+    strength = std::move(walked.values);
     if (trees_walked != nullptr) *trees_walked = walked.trees;
   } else {
     // Fallback (§3.4): mean Ê along the shared boundary, rescaled to [0,1] per image.

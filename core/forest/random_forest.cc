@@ -4,6 +4,8 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <numeric>
+#include <opencv2/core/utility.hpp>
 #include <string>
 #include <thread>
 #include <utility>
@@ -221,36 +223,90 @@ void RandomForest::AccumulateTreeRange(const cv::Mat1f& features, int tree_begin
                   std::min(tree_end, num_trees()), sums);
 }
 
-std::vector<float> RandomForest::PredictBatchScreened(const cv::Mat1f& features, int screen_trees,
-                                                      float final_at_most) const {
-  if (screen_trees <= 0 || screen_trees >= num_trees()) return PredictBatch(features);
-  if (features.rows <= 0) return {};
-  if (features.cols != num_features_) return {};
-  const int count = features.rows;
-  std::vector<const float*> rows(count);
-  for (int r = 0; r < count; ++r) rows[r] = features[r];
-  std::vector<double> sums(static_cast<std::size_t>(count), 0.0);
-  AccumulateTrees(rows.data(), count, 0, screen_trees, sums.data());
-  std::vector<float> out(count);
-  // The rows that go on keep their partial sums, so their totals are PredictBatch's.
-  std::vector<const float*> going_on_rows;
-  std::vector<double> going_on_sums;
-  std::vector<int> going_on;
-  for (int r = 0; r < count; ++r) {
-    const float screened = static_cast<float>(sums[r] / static_cast<double>(screen_trees));
-    if (screened <= final_at_most) {
-      out[r] = screened;
-    } else {
-      going_on.push_back(r);
-      going_on_rows.push_back(rows[r]);
-      going_on_sums.push_back(sums[r]);
+namespace {
+
+// The rows a piecewise walk still goes on with: their features, sums so far and row indices.
+struct RowsGoingOn {
+  std::vector<const float*> rows;
+  std::vector<double> sums;
+  std::vector<int> index;
+};
+
+// The screening step: rows whose mean over the first `trees` trees is at most `bound` stop with
+// it (written to values); the others stay, in order, with their sums.
+void StopRowsAtOrUnder(RowsGoingOn& walk, int trees, float bound, std::vector<float>& values) {
+  std::size_t kept = 0;
+  for (std::size_t r = 0; r < walk.rows.size(); ++r) {
+    const float mean = static_cast<float>(walk.sums[r] / static_cast<double>(trees));
+    if (mean <= bound) {
+      values[walk.index[r]] = mean;
+      continue;
     }
+    walk.rows[kept] = walk.rows[r];
+    walk.sums[kept] = walk.sums[r];
+    walk.index[kept] = walk.index[r];
+    ++kept;
   }
-  AccumulateTrees(going_on_rows.data(), static_cast<int>(going_on.size()), screen_trees,
-                  num_trees(), going_on_sums.data());
-  const auto trees = static_cast<double>(num_trees());
-  for (std::size_t k = 0; k < going_on.size(); ++k)
-    out[going_on[k]] = static_cast<float>(going_on_sums[k] / trees);
+  walk.rows.resize(kept);
+  walk.sums.resize(kept);
+  walk.index.resize(kept);
+}
+
+}  // namespace
+
+void RandomForest::AccumulateOnThreads(const std::vector<const float*>& rows, int tree_begin,
+                                       int tree_end, std::vector<double>& sums, int threads) const {
+  const int count = static_cast<int>(rows.size());
+  const int shares =
+      std::clamp(count / ForestWalkOptions::kMinRowsPerThread, 1, std::max(1, threads));
+  const auto walk_share = [&](int p) {
+    const int begin = count * p / shares, end = count * (p + 1) / shares;
+    AccumulateTrees(rows.data() + begin, end - begin, tree_begin, tree_end, sums.data() + begin);
+  };
+  if (shares == 1) return walk_share(0);
+  cv::parallel_for_(cv::Range(0, shares), [&](const cv::Range& range) {
+    for (int p = range.start; p < range.end; ++p) walk_share(p);
+  });
+}
+
+ForestWalk RandomForest::PredictBatchScreened(const cv::Mat1f& features,
+                                              const ForestWalkOptions& options) const {
+  ForestWalk out;
+  if (features.rows <= 0) {
+    out.trees = num_trees();  // nothing to walk: no tree is left out
+    return out;
+  }
+  if (tree_roots_.empty()) {
+    out.values.assign(static_cast<std::size_t>(features.rows), 0.f);
+    return out;
+  }
+  if (features.cols != num_features_) return out;
+  const int trees = num_trees();
+  const bool screened = options.screening.trees > 0 && options.screening.trees < trees;
+  const int per_piece = options.trees_per_piece > 0 ? options.trees_per_piece : trees;
+  const auto count = static_cast<std::size_t>(features.rows);
+  out.values.assign(count, 0.f);
+  RowsGoingOn walk{std::vector<const float*>(count), std::vector<double>(count, 0.0),
+                   std::vector<int>(count)};
+  for (int r = 0; r < features.rows; ++r) walk.rows[r] = features[r];
+  std::iota(walk.index.begin(), walk.index.end(), 0);
+  // Pieces add in tree order to the rows' sums, so however the walk is cut the sums are one
+  // walk's (AccumulateTrees); a row that stops at the screening keeps its mean over those trees.
+  while (out.trees < trees) {
+    const int first = out.trees;
+    const int last =
+        std::min(trees, first == 0 && screened ? options.screening.trees : first + per_piece);
+    AccumulateOnThreads(walk.rows, first, last, walk.sums, options.threads);
+    out.trees = last;
+    if (first == 0 && screened) {
+      StopRowsAtOrUnder(walk, last, options.screening.final_at_most, out.values);
+    }
+    if (std::chrono::steady_clock::now() >= options.deadline) break;
+  }
+  const auto walked = static_cast<double>(out.trees);
+  for (std::size_t k = 0; k < walk.index.size(); ++k) {
+    out.values[walk.index[k]] = static_cast<float>(walk.sums[k] / walked);
+  }
   return out;
 }
 

@@ -4,6 +4,7 @@
 // Stored in a compact little-endian binary form that loads in milliseconds.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
@@ -26,13 +27,35 @@ struct ForestParams {
   int threads = 0;  // 0 = hardware concurrency
 };
 
-// Early exit over a forest's trees in their stored order (PredictBatchScreened): a row whose
-// mean over the first `trees` trees is at most `final_at_most` keeps that mean; every other row
-// gets the whole forest, exactly as without screening. trees = 0: every tree on every row (the
-// reference).
+// Early exit over a forest's trees in their stored order (a cascade, PredictBatchScreened): every
+// row is first walked through the first `trees` trees; a row whose mean over them is at most
+// `final_at_most` keeps that mean, every other row goes on through the rest, exactly as without
+// screening. trees <= 0 or >= the forest's: every tree on every row (the reference). The trees
+// of a forest are drawn alike, so the first ones' mean estimates the whole forest's; a caller
+// picks `final_at_most` where the difference no longer matters.
 struct ForestScreening {
   int trees = 0;
   float final_at_most = 0.f;
+};
+
+// How RandomForest::PredictBatchScreened walks a batch.
+struct ForestWalkOptions {
+  ForestScreening screening;
+  // After the screening trees (or from the first tree without screening) the trees are walked
+  // this many at a time (0: all that are left at once), and no piece starts once `deadline` has
+  // passed: the rows still going on then get the mean of the trees walked so far. A caller that
+  // must bound its time (a frame budget) sets both.
+  int trees_per_piece = 0;
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  // The rows of a piece are split over up to this many of OpenCV's threads (each share at least
+  // kMinRowsPerThread rows); every row's sum is the same whichever thread walks it.
+  int threads = 1;
+  static constexpr int kMinRowsPerThread = 2048;
+};
+
+struct ForestWalk {
+  std::vector<float> values;  // one per row
+  int trees = 0;              // trees walked for the rows that went on past the screening
 };
 
 class RandomForest {
@@ -55,20 +78,17 @@ class RandomForest {
   // [0, features.rows).
   std::vector<float> PredictBatch(const cv::Mat1f& features, const std::vector<int>& subset) const;
 
-  // Early exit (a cascade over the trees in their stored order): every row is first walked
-  // through the first `screen_trees` trees; a row whose mean over them is at most
-  // `final_at_most` gets that mean, every other row the whole forest's mean, bit-identical to
-  // PredictBatch. screen_trees <= 0 or >= num_trees(): exactly PredictBatch. The trees of a
-  // forest are drawn alike, so the first ones' mean estimates the whole forest's; a caller picks
-  // `final_at_most` where the difference no longer matters (PixelEdgeClassifier::Compute).
-  std::vector<float> PredictBatchScreened(const cv::Mat1f& features, int screen_trees,
-                                          float final_at_most) const;
+  // The batch walk in pieces of trees, with the early exit and a deadline (the one walk behind
+  // the pixel edge classifier's and the occlusion classifier's, ForestWalkOptions). Without
+  // screening, pieces or deadline its values are PredictBatch's, bit for bit. Empty values when
+  // features.cols != num_features() (for a non-empty forest).
+  ForestWalk PredictBatchScreened(const cv::Mat1f& features,
+                                  const ForestWalkOptions& options) const;
 
   // The walk in pieces of trees: adds, for every row of `features`, the outputs of trees
   // [tree_begin, tree_end) (clamped to the forest) to sums[row], in tree order. Calls over
   // consecutive ranges from 0 to num_trees() leave in sums what PredictBatch divides by
-  // num_trees(), bit for bit. A caller that must stop early (a frame budget) stops between
-  // ranges. Does nothing when features.cols != num_features().
+  // num_trees(), bit for bit. Does nothing when features.cols != num_features().
   void AccumulateTreeRange(const cv::Mat1f& features, int tree_begin, int tree_end,
                            double* sums) const;
 
@@ -100,6 +120,9 @@ class RandomForest {
   // blocks of rows (PredictionBlockRows).
   void AccumulateTrees(const float* const* rows, int count, int tree_begin, int tree_end,
                        double* sums) const;
+  // AccumulateTrees for `rows`, split over up to `threads` threads (ForestWalkOptions::threads).
+  void AccumulateOnThreads(const std::vector<const float*>& rows, int tree_begin, int tree_end,
+                           std::vector<double>& sums, int threads) const;
   // Rebuilds compact_ from nodes_ and tree_roots_; called whenever those change.
   void PackForPrediction();
 

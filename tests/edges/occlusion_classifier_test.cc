@@ -523,8 +523,10 @@ TEST_F(TrainedOcclusionTest, ScreenedPaintIsTheMapOfTheScreenedPairValues) {
   ASSERT_TRUE(screened.ok());
   EXPECT_EQ(walked, classifier_->num_trees());
   const SuperpixelPairs pairs = ComputeSuperpixelPairs(f.image, f.enhanced_edge, f.superpixels, {});
-  const std::vector<float> values = classifier_->forest().PredictBatchScreened(
-      pairs.features, screening.trees, screening.final_at_most);
+  ForestWalkOptions walk;
+  walk.screening = screening;
+  const std::vector<float> values =
+      classifier_->forest().PredictBatchScreened(pairs.features, walk).values;
   cv::Mat1f by_hand(f.image.size(), 0.f);
   by_hand.setTo(classifier_->params().floor, f.superpixels.labels == 0);
   for (std::size_t i = 0; i < pairs.boundary_pixels.size(); ++i) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -184,6 +185,14 @@ TEST(BatchPrediction, ManyBlocksMatchPredictBitForBit) {
   for (std::size_t k = 0; k < subset.size(); ++k) EXPECT_EQ(some[k], batch[subset[k]]) << k;
 }
 
+// The screened walk in one piece, on one thread, without a deadline.
+std::vector<float> Screened(const RandomForest& forest, const cv::Mat1f& rows, int trees,
+                            float final_at_most) {
+  ForestWalkOptions walk;
+  walk.screening = ForestScreening{.trees = trees, .final_at_most = final_at_most};
+  return forest.PredictBatchScreened(rows, walk).values;
+}
+
 // The walk in pieces of trees (what a frame budget stops between): consecutive ranges add up to
 // PredictBatch's sums bit for bit; ranges are clamped to the forest; a wrong width adds nothing.
 TEST(BatchPrediction, TreeRangesAddUpToPredictBatchBitForBit) {
@@ -201,7 +210,7 @@ TEST(BatchPrediction, TreeRangesAddUpToPredictBatchBitForBit) {
   // The first trees alone: their mean, as the screened walk stops at it.
   std::vector<double> first(3000, 0.0);
   forest.AccumulateTreeRange(test.x, 0, 4, first.data());
-  const std::vector<float> screened = forest.PredictBatchScreened(test.x, 4, 1e9f);
+  const std::vector<float> screened = Screened(forest, test.x, 4, 1e9f);
   for (int r = 0; r < test.x.rows; ++r)
     ASSERT_EQ(static_cast<float>(first[r] / 4.0), screened[r]) << r;
   std::vector<double> untouched(3000, 0.0);
@@ -289,7 +298,7 @@ TEST(ScreenedPrediction, HandBuiltForestStopsOnlyTheRowsAtOrUnderTheBound) {
   rows(1, 0) = 0.9f, rows(1, 1) = 0.1f;  // a = 2
   rows(2, 0) = 0.9f, rows(2, 1) = 0.9f;  // a = 4
   const std::vector<float> full = forest.PredictBatch(rows);
-  const std::vector<float> screened = forest.PredictBatchScreened(rows, 1, 2.f);
+  const std::vector<float> screened = Screened(forest, rows, 1, 2.f);
   ASSERT_EQ(screened.size(), 3u);
   EXPECT_EQ(screened[0], 1.f);  // the first tree's value: at or under the bound
   EXPECT_EQ(screened[1], 2.f);
@@ -310,10 +319,10 @@ TEST(ScreenedPrediction, TrainedForestGoesOnBitForBitAndStopsAtTheFirstTreesMean
   ASSERT_EQ(forest.num_trees(), 12);
   const Data test = MakeData(20000, 6, 6);
   const std::vector<float> full = forest.PredictBatch(test.x);
-  EXPECT_EQ(forest.PredictBatchScreened(test.x, 0, 0.5f), full);
-  EXPECT_EQ(forest.PredictBatchScreened(test.x, 12, 0.5f), full);
+  EXPECT_EQ(Screened(forest, test.x, 0, 0.5f), full);
+  EXPECT_EQ(Screened(forest, test.x, 12, 0.5f), full);
   const float bound = 0.4f;
-  const std::vector<float> screened = forest.PredictBatchScreened(test.x, 4, bound);
+  const std::vector<float> screened = Screened(forest, test.x, 4, bound);
   ASSERT_EQ(screened.size(), full.size());
   int stopped = 0, went_on = 0;
   for (int r = 0; r < test.x.rows; ++r) {
@@ -327,6 +336,43 @@ TEST(ScreenedPrediction, TrainedForestGoesOnBitForBitAndStopsAtTheFirstTreesMean
   // Both kinds occur, so both paths are exercised.
   EXPECT_GT(stopped, 1000);
   EXPECT_GT(went_on, 1000);
+}
+
+// Pieces of trees and threads change nothing; a deadline already past stops the walk after its
+// first piece (the screening trees when screening), and the rows still going on get the mean of
+// the trees walked; no rows: no tree is left out.
+TEST(ScreenedPrediction, PiecesThreadsAndADeadlineWalkTheSameSums) {
+  const Data train = MakeData(3000, 6, 5);
+  ForestParams p;
+  p.num_trees = 12;
+  p.min_leaf_size = 3;
+  p.threads = 1;
+  const RandomForest forest = FittedForest(train.x, train.y, p);
+  const Data test = MakeData(9000, 6, 7);
+  const std::vector<float> one_piece = Screened(forest, test.x, 4, 0.4f);
+  ForestWalkOptions walk;
+  walk.screening = ForestScreening{.trees = 4, .final_at_most = 0.4f};
+  walk.trees_per_piece = 3;
+  walk.threads = 2;
+  const ForestWalk pieces = forest.PredictBatchScreened(test.x, walk);
+  EXPECT_EQ(pieces.trees, 12);
+  EXPECT_EQ(pieces.values, one_piece);
+
+  walk.deadline = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+  const ForestWalk stopped = forest.PredictBatchScreened(test.x, walk);
+  EXPECT_EQ(stopped.trees, 4);
+  std::vector<double> first(9000, 0.0);
+  forest.AccumulateTreeRange(test.x, 0, 4, first.data());
+  int mismatches = 0;
+  for (int r = 0; r < test.x.rows; ++r)
+    mismatches += static_cast<float>(first[r] / 4.0) != stopped.values[r];
+  EXPECT_EQ(mismatches, 0);
+
+  walk.screening = ForestScreening{};  // no screening: the first piece is trees_per_piece
+  const ForestWalk unscreened = forest.PredictBatchScreened(test.x, walk);
+  EXPECT_EQ(unscreened.trees, 3);
+  EXPECT_EQ(forest.PredictBatchScreened(cv::Mat1f(0, 6), walk).trees, 12);
+  EXPECT_TRUE(forest.PredictBatchScreened(MakeData(10, 4, 8).x, walk).values.empty());
 }
 
 }  // namespace
