@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <optional>
 
 #include "core/base/memory_usage.h"
 #include "core/edges/edge_labels.h"
@@ -138,10 +139,25 @@ Result<Survey> SurveyFrames(TrainingRun& run) {
   return survey;
 }
 
+// The ground-plane size prior of the training obstacles, fitted on first use: the size filter
+// and both kinds of ground-plane features place the same horizon.
+class GroundPlaneFit {
+ public:
+  explicit GroundPlaneFit(const std::vector<Box>& obstacle_boxes) : boxes_(obstacle_boxes) {}
+  const Result<GroundPlaneSizePrior>& Get() {
+    if (!fitted_) fitted_.emplace(FitGroundPlaneSizePrior(boxes_));
+    return *fitted_;
+  }
+
+ private:
+  const std::vector<Box>& boxes_;
+  std::optional<Result<GroundPlaneSizePrior>> fitted_;
+};
+
 // The size filter of `--regions auto` bundles: the ground-plane prior (ours, README "Real
 // frames") or the authors' per-band extremes (§4.3). Recorded in parts["size_filter"].
-Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
-                        nlohmann::json& parts) {
+Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, GroundPlaneFit& ground_plane,
+                        ModelBundle& bundle, nlohmann::json& parts) {
   const std::string& recipe = run.options().size_filter_recipe;
   if (recipe == "bands") {
     bundle.size_filter = SizeFilter::Derive(survey.obstacle_boxes);
@@ -151,7 +167,7 @@ Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, ModelBundle& bun
   if (recipe != "ground_plane")
     return Status::InvalidArgument("--size-filter-recipe must be ground_plane or bands, got '" +
                                    recipe + "'");
-  const auto prior = FitGroundPlaneSizePrior(survey.obstacle_boxes);
+  const Result<GroundPlaneSizePrior>& prior = ground_plane.Get();
   if (!prior.ok())
     return prior.status().WithContext(
         "fitting the size filter's ground-plane prior (too few "
@@ -174,9 +190,10 @@ Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, ModelBundle& bun
 // With ground-plane sizes (PipelineParams::box_features, occlusion_features), their horizon: the
 // one the ground-plane size prior fits to the training obstacles, whatever the size filter's
 // recipe. `choice` is the option's value, `flag` its name, `part` the manifest key.
-Status PlaceGroundPlaneHorizon(TrainingRun& run, const Survey& survey, const std::string& choice,
-                               const std::string& flag, const std::string& part,
-                               GroundPlaneFeatureParams& params, nlohmann::json& parts) {
+Status PlaceGroundPlaneHorizon(TrainingRun& run, GroundPlaneFit& ground_plane,
+                               const std::string& choice, const std::string& flag,
+                               const std::string& part, GroundPlaneFeatureParams& params,
+                               nlohmann::json& parts) {
   if (choice != "ground_plane" && choice != "paper")
     return Status::InvalidArgument(flag + " must be ground_plane or paper, got '" + choice + "'");
   params.ground_plane_size = choice == "ground_plane";
@@ -184,7 +201,7 @@ Status PlaceGroundPlaneHorizon(TrainingRun& run, const Survey& survey, const std
     parts[part] = {{"size", "paper"}};
     return Status::Ok();
   }
-  const auto prior = FitGroundPlaneSizePrior(survey.obstacle_boxes);
+  const Result<GroundPlaneSizePrior>& prior = ground_plane.Get();
   if (!prior.ok())
     return prior.status().WithContext("placing the horizon of the ground-plane " + part +
                                       " (too few obstacles? " + flag + " paper needs none)");
@@ -196,15 +213,15 @@ Status PlaceGroundPlaneHorizon(TrainingRun& run, const Survey& survey, const std
   return Status::Ok();
 }
 
-Status PlaceFeatureHorizons(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
+Status PlaceFeatureHorizons(TrainingRun& run, GroundPlaneFit& ground_plane, ModelBundle& bundle,
                             nlohmann::json& parts) {
   const TrainOptions& options = run.options();
-  if (Status st =
-          PlaceGroundPlaneHorizon(run, survey, options.box_size_features, "--box-size-features",
-                                  "box_features", bundle.params.box_features, parts);
+  if (Status st = PlaceGroundPlaneHorizon(run, ground_plane, options.box_size_features,
+                                          "--box-size-features", "box_features",
+                                          bundle.params.box_features, parts);
       !st.ok())
     return st;
-  return PlaceGroundPlaneHorizon(run, survey, options.occlusion_size_features,
+  return PlaceGroundPlaneHorizon(run, ground_plane, options.occlusion_size_features,
                                  "--occlusion-size-features", "occlusion_features",
                                  bundle.params.occlusion_features, parts);
 }
@@ -213,12 +230,14 @@ Status PlaceFeatureHorizons(TrainingRun& run, const Survey& survey, ModelBundle&
 Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
                       nlohmann::json& parts) {
   const TrainOptions& options = run.options();
+  GroundPlaneFit ground_plane(survey.obstacle_boxes);
   if (options.regions == "laf2020") {
     bundle.regions = Laf2020Regions().ScaledTo(survey.width, survey.height);
     bundle.size_filter = SizeFilter::Laf2020();
     parts["size_filter"] = {{"recipe", "laf2020"}};
     if (survey.width != 2048 || survey.height != 1024) {
-      if (Status st = DeriveSizeFilter(run, survey, bundle, parts); !st.ok()) return st;
+      if (Status st = DeriveSizeFilter(run, survey, ground_plane, bundle, parts); !st.ok())
+        return st;
     }
   } else if (options.regions == "auto") {
     RegionParams region_params = options.params.regions;
@@ -227,13 +246,13 @@ Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundl
         DeriveMultilayerRegions(survey.footprints, survey.width, survey.height, region_params);
     if (!regions.ok()) return regions.status().WithContext("deriving the multilayer regions");
     bundle.regions = *regions;
-    if (Status st = DeriveSizeFilter(run, survey, bundle, parts); !st.ok()) return st;
+    if (Status st = DeriveSizeFilter(run, survey, ground_plane, bundle, parts); !st.ok()) return st;
   } else {
     return Status::InvalidArgument("--regions must be auto or laf2020, got '" + options.regions +
                                    "'");
   }
   bundle.size_filter.enabled = options.params.size_filter;
-  if (Status st = PlaceFeatureHorizons(run, survey, bundle, parts); !st.ok()) return st;
+  if (Status st = PlaceFeatureHorizons(run, ground_plane, bundle, parts); !st.ok()) return st;
   for (int k = 0; k < bundle.regions.num_layers(); ++k) {
     const Box& r = bundle.regions.layers[k];
     char line[96];  // snprintf: GCC 12 warns (-Wrestrict, falsely) on "R" + std::to_string
