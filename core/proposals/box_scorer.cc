@@ -252,6 +252,14 @@ void BoxScorer::ScoreImpl(ScoreWindow& w, float bar, bool use_bound) {
   w.score = ScoreAfterBound(w, inner_r0, inner_c0, inner_r1, inner_c1, norm, bar);
 }
 
+std::int64_t BoxScorer::HopefulThreshold(float norm, float bar) {
+  if (threshold_cache_.norm != norm || threshold_cache_.bar != bar) {
+    threshold_cache_ = CachedThreshold{
+        norm, bar, t_->bound.SmallestHopeful([&](double v) { return Hopeless(v, norm, bar); })};
+  }
+  return threshold_cache_.fixed;
+}
+
 int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
                            const RowRanges* tops, float bar, std::vector<ScoreWindow>& nonzero,
                            std::vector<int>* rows) {
@@ -281,8 +289,7 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
   if (box_height >= 0 && unclamped_end > 0) {
     const int half_h = box_height / 2, inner_offset = half_h / 2;
     const float norm = t_->norm[half_w + half_h];
-    const std::int64_t threshold =
-        t_->bound.SmallestHopeful([&](double v) { return Hopeless(v, norm, bar); });
+    const std::int64_t threshold = HopefulThreshold(norm, bar);
     // Three passes over the column, each window in grid order as Score() would take it; a pass
     // only keeps the windows the next one needs. Why it is faster: the windows that pass the
     // bound are scattered over the column, so their integral-image loads miss the cache. Between

@@ -22,6 +22,24 @@ namespace {
 constexpr int kBinCount = 4096;  // log(area) / log(1/t) stays far below this
 constexpr long long kMaxCells = 1 << 22;
 
+// BoxIoU(a, b) > t for two non-empty boxes and t in (0, 1), without BoxIoU's division unless
+// the ratio lies within a billionth of t. The same answer: intersection and union are exact
+// integers, and the quotient's rounding (and that of t * union) is ~1e-16 relative. The division
+// was a fifth of the NMS on real frames.
+bool IoUAbove(const Box& a, const Box& b, double t) {
+  const long long iw = static_cast<long long>(std::min(a.right(), b.right())) - std::max(a.x, b.x);
+  if (iw <= 0) return false;
+  const long long ih =
+      static_cast<long long>(std::min(a.bottom(), b.bottom())) - std::max(a.y, b.y);
+  if (ih <= 0) return false;
+  const long long inter = iw * ih;
+  const double needed = t * static_cast<double>(a.area() + b.area() - inter);
+  const auto got = static_cast<double>(inter);
+  if (got > needed * (1.0 + 1e-9)) return true;
+  if (got < needed * (1.0 - 1e-9)) return false;
+  return BoxIoU(a, b) > t;
+}
+
 }  // namespace
 
 GreedyNms::GreedyNms(float iou_threshold, int max_boxes, int min_x, int min_y, int max_x, int max_y)
@@ -68,7 +86,7 @@ bool GreedyNms::Suppressed(const Box& candidate) const {
   const long long ry = static_cast<long long>(radius_factor_ * candidate.h) + 2;
   const auto suppressed_in_cell = [&](const Grid& g, int gx, int gy) {
     for (int e = g.head[static_cast<size_t>(gx) * g.rows + gy]; e >= 0; e = entries_[e].next) {
-      if (BoxIoU(candidate, entries_[e].box) > threshold_) return true;
+      if (IoUAbove(candidate, entries_[e].box, threshold_)) return true;
     }
     return false;
   };

@@ -282,10 +282,11 @@ std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxPara
                                       float provisional_bar) {
   // Most walks run for windows that score far below the last box NMS keeps (max_boxes of them).
   // The provisional scan skips those (the containment bound and the early exit reject many more
-  // windows, and walks stop sooner). On 2048 x 1024 synthetic frames the last box NMS keeps per
-  // region scores 2-3.3 x min_score and the refined local maxima at least 2 x, so a bar of
-  // 1.5 x settles every region there in one scan, with ~10 % fewer walks. A small grid is unlikely
-  // to fill max_boxes at all, and a scan that does not settle is wasted: such grids skip it.
+  // windows, and walks stop sooner). It settles only where NMS fills max_boxes: on the synthetic
+  // frames of an earlier synthetic-trained model (last box 2-3.3 x min_score) every region did,
+  // on real frames with real-trained models almost none does (window_scan.h). A small grid is
+  // unlikely to fill max_boxes at all, and a scan that does not settle is wasted: such grids
+  // skip it.
   const bool bar_applies =
       provisional_bar > 1.f && params.max_boxes > 0 &&
       CountWindows(scorer.width(), scorer.height(), params) >=

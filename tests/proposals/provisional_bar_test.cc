@@ -46,7 +46,7 @@ TEST(ProvisionalBarTest, SettledScanIsExactWithFewerWalks) {
     const cv::Mat1f map = testing::RandomContourMap(140, 100, static_cast<unsigned>(seed), 14);
     const EdgeBoxParams params = LimitedRefinement(6);
     const Scan plain = ScanGrid(map, params, 0.f);
-    const Scan barred = ScanGrid(map, params, kDefaultProvisionalBar);
+    const Scan barred = ScanGrid(map, params, kProvisionalBar);
     ASSERT_EQ(plain.boxes.size(), 6u) << "the test needs a grid that fills max_boxes";
     EXPECT_EQ(barred.stats.rescans, 0) << seed;
     EXPECT_LT(barred.stats.scorings, plain.stats.scorings) << seed;
@@ -71,7 +71,7 @@ TEST(ProvisionalBarTest, TooFewLocalMaximaLeftIsNotSettled) {
   EdgeBoxParams params = LimitedRefinement(6);
   params.refine_limit = 100000;  // more than any bar leaves: the refined set would change
   const Scan plain = ScanGrid(map, params, 0.f);
-  const Scan barred = ScanGrid(map, params, kDefaultProvisionalBar);
+  const Scan barred = ScanGrid(map, params, kProvisionalBar);
   EXPECT_EQ(barred.stats.rescans, 1);
   ExpectSameBoxes(barred.boxes, plain.boxes);
 }
@@ -85,7 +85,7 @@ TEST(ProvisionalBarTest, NotTriedWhereItCannotHelp) {
   const EdgeBoxParams small_grid = LimitedRefinement(1000000);
   for (const EdgeBoxParams& params : {paper, small_grid}) {
     const Scan plain = ScanGrid(map, params, 0.f);
-    const Scan barred = ScanGrid(map, params, kDefaultProvisionalBar);
+    const Scan barred = ScanGrid(map, params, kProvisionalBar);
     EXPECT_EQ(barred.stats.rescans, 0);
     EXPECT_EQ(barred.stats.scorings, plain.stats.scorings);
     ExpectSameBoxes(barred.boxes, plain.boxes);
@@ -98,7 +98,7 @@ TEST(ProvisionalBarTest, WithoutRefinementSettledScanIsExact) {
   params.refine = false;
   params.max_boxes = 6;
   const Scan plain = ScanGrid(map, params, 0.f);
-  const Scan barred = ScanGrid(map, params, kDefaultProvisionalBar);
+  const Scan barred = ScanGrid(map, params, kProvisionalBar);
   EXPECT_EQ(barred.stats.rescans, 0);
   ExpectSameBoxes(barred.boxes, plain.boxes);
   // Nothing above the bar: only NMS not filling up tells that the scan did not settle.
