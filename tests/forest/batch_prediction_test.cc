@@ -306,16 +306,21 @@ TEST(ScreenedPrediction, HandBuiltForestStopsOnlyTheRowsAtOrUnderTheBound) {
   EXPECT_EQ(full[2], Mean3(4.0));
 }
 
-// Screening off (no trees, or every tree) is PredictBatch itself, and on a trained forest every
-// row that goes on is bit-identical to PredictBatch while the stopped ones hold the first
-// trees' mean, at or under the bound: over many blocks of rows.
-TEST(ScreenedPrediction, TrainedForestGoesOnBitForBitAndStopsAtTheFirstTreesMean) {
+// A forest of 12 trees fitted to 3000 rows of 6 features (the screening tests' forest).
+RandomForest TwelveTreeForest() {
   const Data train = MakeData(3000, 6, 5);
   ForestParams p;
   p.num_trees = 12;
   p.min_leaf_size = 3;
   p.threads = 1;
-  const RandomForest forest = FittedForest(train.x, train.y, p);
+  return FittedForest(train.x, train.y, p);
+}
+
+// Screening off (no trees, or every tree) is PredictBatch itself, and on a trained forest every
+// row that goes on is bit-identical to PredictBatch while the stopped ones hold the first
+// trees' mean, at or under the bound: over many blocks of rows.
+TEST(ScreenedPrediction, TrainedForestGoesOnBitForBitAndStopsAtTheFirstTreesMean) {
+  const RandomForest forest = TwelveTreeForest();
   ASSERT_EQ(forest.num_trees(), 12);
   const Data test = MakeData(20000, 6, 6);
   const std::vector<float> full = forest.PredictBatch(test.x);
@@ -342,12 +347,7 @@ TEST(ScreenedPrediction, TrainedForestGoesOnBitForBitAndStopsAtTheFirstTreesMean
 // first piece (the screening trees when screening), and the rows still going on get the mean of
 // the trees walked; no rows: no tree is left out.
 TEST(ScreenedPrediction, PiecesThreadsAndADeadlineWalkTheSameSums) {
-  const Data train = MakeData(3000, 6, 5);
-  ForestParams p;
-  p.num_trees = 12;
-  p.min_leaf_size = 3;
-  p.threads = 1;
-  const RandomForest forest = FittedForest(train.x, train.y, p);
+  const RandomForest forest = TwelveTreeForest();
   const Data test = MakeData(9000, 6, 7);
   const std::vector<float> one_piece = Screened(forest, test.x, 4, 0.4f);
   ForestWalkOptions walk;
