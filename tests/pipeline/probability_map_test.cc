@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+
 namespace tod {
 namespace {
 
@@ -66,6 +69,64 @@ TEST(ProbabilityMap, ThresholdedComponentsCarryBoxAreaPeakAndMean) {
   EXPECT_NEAR(comps[0].mean, (19 * 0.8 + 1.0) / 20, 1e-6);
   EXPECT_EQ(comps[1].box, (Box{20, 10, 3, 3}));
   EXPECT_TRUE(ThresholdObstacles(p, 1.0f).empty());
+}
+
+// The reference: the components labelled on the whole map (what ThresholdObstacles did before
+// it labelled only the mask's bounding box).
+std::vector<ObstacleComponent> WholeMapComponents(const cv::Mat1f& probability, float threshold) {
+  const cv::Mat1b mask = probability > threshold;
+  cv::Mat1i labels;
+  cv::Mat stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<ObstacleComponent> out(std::max(0, n - 1));
+  std::vector<double> sums(out.size(), 0.0);
+  for (int y = 0; y < labels.rows; ++y)
+    for (int x = 0; x < labels.cols; ++x) {
+      const int l = labels(y, x);
+      if (l == 0) continue;
+      out[l - 1].peak = std::max(out[l - 1].peak, probability(y, x));
+      sums[l - 1] += probability(y, x);
+    }
+  for (int l = 1; l < n; ++l) {
+    ObstacleComponent& c = out[l - 1];
+    c.box = {stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+             stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT)};
+    c.area = stats.at<int>(l, cv::CC_STAT_AREA);
+    c.mean = static_cast<float>(sums[l - 1] / c.area);
+  }
+  std::stable_sort(
+      out.begin(), out.end(),
+      [](const ObstacleComponent& a, const ObstacleComponent& b) { return a.peak > b.peak; });
+  return out;
+}
+
+// Labelled on the mask's bounding box (grown to even coordinates) or on the whole map, the
+// components are the same, in the same order, also where many share one peak value and the box
+// starts at odd coordinates.
+TEST(ProbabilityMap, ComponentsOfTheMasksBoundingBoxAreThoseOfTheWholeMap) {
+  cv::RNG rng(7);
+  for (int trial = 0; trial < 40; ++trial) {
+    cv::Mat1f p(97, 131, 0.f);
+    const int boxes = rng.uniform(1, 60);
+    for (int i = 0; i < boxes; ++i) {
+      const int x = rng.uniform(3, 120), y = rng.uniform(5, 90);
+      const cv::Rect r(x, y, std::min(rng.uniform(1, 9), 131 - x),
+                       std::min(rng.uniform(1, 7), 97 - y));
+      p(r) += 0.25f * static_cast<float>(rng.uniform(1, 4));  // few distinct values: equal peaks
+    }
+    for (const float threshold : {0.f, 0.3f, 0.6f}) {
+      const std::vector<ObstacleComponent> got = ThresholdObstacles(p, threshold);
+      const std::vector<ObstacleComponent> want = WholeMapComponents(p, threshold);
+      ASSERT_EQ(got.size(), want.size()) << trial << " " << threshold;
+      for (std::size_t k = 0; k < got.size(); ++k) {
+        EXPECT_EQ(got[k].box, want[k].box) << trial << " " << threshold << " " << k;
+        EXPECT_EQ(got[k].area, want[k].area);
+        EXPECT_EQ(got[k].peak, want[k].peak);
+        EXPECT_EQ(got[k].mean, want[k].mean);
+      }
+    }
+  }
+  EXPECT_TRUE(ThresholdObstacles(cv::Mat1f(8, 8, 0.f), 0.f).empty());
 }
 
 TEST(RankedAboveThreshold, StrictAndSorted) {
