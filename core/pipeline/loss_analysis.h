@@ -2,7 +2,9 @@
 // pipeline. Per ground-truth obstacle: is its contour in the base edge map and in the occlusion
 // edge map, is any proposal a hit before and after the size filter, is a hit among the first 1000
 // proposals by objectness, and among the first 1000 by regressed score. Per frame: how dense the
-// edge maps are and how much work the proposal stage does. This is how the README's "Real frames"
+// edge maps are and how much work the proposal stage does, and how the fused scores of the boxes
+// on an obstacle compare with those of the boxes on none. Over the split: where the pixel AP of
+// the paper's map (BP+Fusion@4) goes (PixelApBreakdown). This is how the README's "Real frames"
 // figures were found; it runs the pipeline's own stage functions, nothing else.
 #pragma once
 
@@ -50,11 +52,31 @@ struct FrameWork {
   int superpixels = 0;
   long long windows_scored = 0;  // over the K regions, size filter admission on
   long long proposals = 0;       // after the size filter, all regions
+  // Fused scores F (§6.5) of the proposals: the best of a box that covers an obstacle pixel, the
+  // best of a box that covers none (a false box), and how many false boxes score above the
+  // best box on an obstacle.
+  float best_obstacle_box_score = 0.f;
+  float best_false_box_score = 0.f;
+  long long false_boxes_above = 0;
+};
+
+// Pixel AP of the paper's map (§7) of BP+Fusion@4 over the split, pooled as `tod eval` pools it,
+// from the same proposals with three scorings: as served; with every false box (one that covers
+// no obstacle pixel) scored 0, i.e. what rejecting the false boxes perfectly would give; and
+// with the fused score perfect regressors would give, ORDR = OBDR = the box's mask IoU (§6.4),
+// gated and fused as served. The gap between the first two is what the false boxes cost, the
+// gap to the third what the scores cost in all; what the third misses, the proposals and the
+// map's shape do.
+struct PixelApBreakdown {
+  double served = 0;
+  double false_boxes_removed = 0;
+  double perfect_scores = 0;
 };
 
 struct LossAnalysis {
   std::vector<ObstacleFate> obstacles;
   std::vector<FrameWork> frames;
+  PixelApBreakdown pixel_ap;
 };
 
 Result<LossAnalysis> AnalyseLosses(const ModelBundle& bundle, const LossAnalysisOptions& options);

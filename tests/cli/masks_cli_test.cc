@@ -127,10 +127,28 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
                           "obstacle_free_frames", "instances_found"})
     EXPECT_TRUE(j["obstacles"].contains(key)) << key;
 
-  const CommandResult analyse = RunCommand(tod_ + " analyse --data " + Root() +
-                                           " --split test --model " + model + " --threads 2");
+  const std::string analysis_json = (out_ / "analysis.json").string();
+  const CommandResult analyse =
+      RunCommand(tod_ + " analyse --data " + Root() + " --split test --model " + model +
+                 " --threads 2 --json " + analysis_json);
   ASSERT_EQ(analyse.exit_code, 0) << analyse.output;
   EXPECT_NE(analyse.output.find("Where obstacles are lost"), std::string::npos);
+  EXPECT_NE(analyse.output.find("Pixel AP of the paper's map"), std::string::npos)
+      << analyse.output;
+  std::ifstream analysis_in(analysis_json);
+  const nlohmann::json a = nlohmann::json::parse(analysis_in);
+  // The served scoring is the detector's own: the same proposals, map and pooling as the AP
+  // `tod eval` reports for BP+Fusion@4 on the same split.
+  EXPECT_NEAR(a["pixel_ap"]["served"].get<double>(),
+              j["regression"]["BP+Fusion@4"]["ap"].get<double>(), 1e-9)
+      << a["pixel_ap"].dump();
+  for (const char* key : {"false_boxes_removed", "perfect_scores"})
+    EXPECT_TRUE(a["pixel_ap"][key].is_number()) << key;
+  ASSERT_FALSE(a["frames"].empty());
+  for (const nlohmann::json& frame : a["frames"]) {
+    EXPECT_GE(frame["best_false_box_score"].get<double>(), 0.0) << frame.dump();
+    EXPECT_GE(frame["false_boxes_above"].get<long long>(), 0) << frame.dump();
+  }
 }
 
 // By default the regressors train a second time on negatives the first round scored highest;
