@@ -1,5 +1,7 @@
 #include "core/pipeline/model_bundle.h"
 
+#include "core/features/box_features.h"
+
 #include <unistd.h>
 
 #include <chrono>
@@ -11,6 +13,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/binary_io.h"
 #include "core/base/checksum.h"
+#include "core/features/box_features.h"
 #include "core/pipeline/json_integers.h"
 
 namespace tod {
@@ -233,8 +236,10 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
     return Status::InvalidArgument(manifest_path + ": unknown edge_source '" + bundle.edge_kind +
                                    "'");
   }
-  if (bundle.ordr.num_features() != 20 || bundle.obdr.num_features() != 20)
-    return Status::DataLoss((root / kOrdrFile).string() + ": regressors must take 20 features");
+  if (bundle.ordr.num_features() != kNumBoxFeatures ||
+      bundle.obdr.num_features() != kNumBoxFeatures)
+    return Status::DataLoss((root / kOrdrFile).string() + ": regressors must take " +
+                            std::to_string(kNumBoxFeatures) + " features");
   return bundle;
 }
 
