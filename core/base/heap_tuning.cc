@@ -9,6 +9,9 @@
 #endif
 
 namespace tod {
+namespace {
+bool heap_arena_shared = false;  // set once in main(), before any thread starts
+}  // namespace
 
 bool RetainLargeAllocations() {
 #if defined(__GLIBC__)
@@ -26,10 +29,13 @@ bool RetainLargeAllocations() {
 bool ShareOneHeapArena() {
 #if defined(__GLIBC__)
   if (std::getenv("MALLOC_ARENA_MAX") != nullptr) return false;  // the operator's choice
-  return mallopt(M_ARENA_MAX, 1) == 1;
+  heap_arena_shared = mallopt(M_ARENA_MAX, 1) == 1;
+  return heap_arena_shared;
 #else
   return false;
 #endif
 }
+
+bool HeapArenaShared() { return heap_arena_shared; }
 
 }  // namespace tod

@@ -22,4 +22,7 @@ bool RetainLargeAllocations();
 // Call once, early in main(), before any thread starts.
 bool ShareOneHeapArena();
 
+// Whether ShareOneHeapArena succeeded in this process (what a benchmark reports beside its RSS).
+bool HeapArenaShared();
+
 }  // namespace tod

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "core/base/atomic_file.h"
+#include "core/base/heap_tuning.h"
 #include "core/cli/commands.h"
 #include "core/cli/request_options.h"
 #include "core/pipeline/frame_bench.h"
@@ -51,6 +52,7 @@ Runner AddBenchCommand(CLI::App& app) {
     std::cerr << "measuring " << frames->size() << " frames (after one warm-up)\n";
     auto report = RunFrameBench(detector, *frames, options);
     if (!report.ok()) return Fail(report.status().message());
+    report->shared_heap = HeapArenaShared();
     std::cout << FormatBenchReport(*report);
     if (!args->json.empty()) {
       const Status written =

@@ -76,7 +76,8 @@ struct FrameBenchReport {
   std::vector<std::pair<std::string, Spread>> counters;  // windows_scored, edge_groups, ...
   // OpenCV Edge Boxes median / our proposals median (> 1: ours is faster).
   double edgeboxes_ratio = 0;
-  double peak_rss_mb = 0;  // of the whole process, after the run
+  double peak_rss_mb = 0;    // of the whole process, after the run
+  bool shared_heap = false;  // every thread allocated from one heap (HeapArenaShared)
 };
 
 // Measures every frame (skipping, and listing, those that fail). Fails only when no frame could
@@ -90,7 +91,7 @@ Result<FrameBenchReport> RunFrameBench(const ObstacleDetector& detector,
 std::string FormatBenchReport(const FrameBenchReport& report);
 
 // {"frames": n, "stages_ms": {STAGE: {"median","p90","max"}}, "proposals_ms": {"median"},
-//  "opencv_edgeboxes_ms": {"median","p90","max"}, "edgeboxes_ratio", "peak_rss_mb",
+//  "opencv_edgeboxes_ms": {"median","p90","max"}, "edgeboxes_ratio", "peak_rss_mb", "shared_heap",
 //  "counters": {NAME: {"median","p90","max"}}, "skipped_frames", "per_frame": [...]}
 nlohmann::json BenchReportToJson(const FrameBenchReport& report);
 

@@ -78,7 +78,8 @@ std::string FormatBenchReport(const FrameBenchReport& report) {
          "boxes)\n"
       << Row("edgeboxes ms", report.edgeboxes_ms, 1)
       << "ratio EdgeBoxes / our proposals (medians): " << Fixed(report.edgeboxes_ratio, 2) << "x\n"
-      << "peak RSS: " << Fixed(report.peak_rss_mb, 1) << " MB\n";
+      << "peak RSS: " << Fixed(report.peak_rss_mb, 1) << " MB ("
+      << (report.shared_heap ? "one heap for all threads" : "a heap per thread") << ")\n";
   for (const SkippedFrame& f : report.skipped)
     out << "skipped " << f.frame << ": " << f.reason << "\n";
   for (const FrameBenchRecord& r : report.records) {
@@ -108,6 +109,7 @@ nlohmann::json BenchReportToJson(const FrameBenchReport& report) {
   j["opencv_edgeboxes_ms"] = SpreadJson(report.edgeboxes_ms);
   j["edgeboxes_ratio"] = report.edgeboxes_ratio;
   j["peak_rss_mb"] = report.peak_rss_mb;
+  j["shared_heap"] = report.shared_heap;
   nlohmann::json counters = nlohmann::json::object();
   for (const auto& [name, spread] : report.counters) counters[name] = SpreadJson(spread);
   j["counters"] = std::move(counters);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -83,6 +84,10 @@ TEST_F(BenchCliTest, TwoFramesGiveTheContractJsonAndTables) {
                    j["stages_ms"]["proposals"]["median"].get<double>());
   EXPECT_GT(j["opencv_edgeboxes_ms"]["median"].get<double>(), 0);
   EXPECT_GT(j["peak_rss_mb"].get<double>(), 0);
+  // tod bench allocates from one heap, as tod_server does, unless the operator set the arenas.
+  if (std::getenv("MALLOC_ARENA_MAX") == nullptr) {
+    EXPECT_EQ(j["shared_heap"], true);
+  }
 
   ASSERT_EQ(j["per_frame"].size(), 2u);
   for (const nlohmann::json& frame : j["per_frame"]) {
