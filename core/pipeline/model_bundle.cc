@@ -1,7 +1,5 @@
 #include "core/pipeline/model_bundle.h"
 
-#include "core/features/box_features.h"
-
 #include <unistd.h>
 
 #include <chrono>
