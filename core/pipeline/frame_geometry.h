@@ -40,7 +40,7 @@ BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, i
 
 // The occlusion classifier's feature options of a bundle for frames of a given size: the
 // ground-plane horizon (PipelineParams::occlusion_features) mapped like the regions' rows.
-// crop_y stays 0: ComputeOcclusionEdges sets it to R1's first row.
+// crop_y stays 0: OcclusionFeaturesOnCrop (frame_stages.h) sets it to R1's first row.
 OcclusionFeatureOptions OcclusionFeatureOptionsForFrame(const ModelBundle& bundle, int width,
                                                         int height);
 

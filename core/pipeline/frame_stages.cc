@@ -16,6 +16,12 @@ namespace tod {
 
 using Clock = std::chrono::steady_clock;
 
+OcclusionFeatureOptions OcclusionFeaturesOnCrop(OcclusionFeatureOptions frame_options,
+                                                const OcclusionEdges& oaocc) {
+  frame_options.crop_y = oaocc.r1.y;
+  return frame_options;
+}
+
 Result<OcclusionEdges> ComputeOcclusionEdges(
     const cv::Mat3b& image, const MultilayerRegions& regions, const EdgeSource& edges,
     const OcclusionClassifier* classifier, const OcclusionFeatureOptions& occlusion_features,
@@ -48,10 +54,8 @@ Result<OcclusionEdges> ComputeOcclusionEdges(
   out.superpixels = std::move(superpixels).value();
   if (mark("superpixels")) return out;
   if (classifier != nullptr) {
-    OcclusionFeatureOptions features = occlusion_features;
-    features.crop_y = out.r1.y;
     const OcclusionPaintOptions paint{
-        .features = features,
+        .features = OcclusionFeaturesOnCrop(occlusion_features, out),
         .screening = params.occlusion_screening,
         .deadline = budget != nullptr ? budget->OcclusionDeadline() : Clock::time_point::max()};
     Result<cv::Mat1f> occlusion =

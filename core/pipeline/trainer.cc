@@ -425,11 +425,10 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
         s.image, bundle.regions, *upstream.edges, nullptr, {}, upstream.params, /*enhance=*/true);
     if (!computed.ok()) return computed.status();
     const OcclusionEdges& oaocc = *computed;
-    OcclusionFeatureOptions features =
-        OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows);
-    features.crop_y = oaocc.r1.y;
-    const OcclusionTrainingFrame frame{oaocc.crop, oaocc.enhanced, oaocc.superpixels,
-                                       LabelMap(s)(oaocc.r1.rect()).clone(), features};
+    const OcclusionTrainingFrame frame{
+        oaocc.crop, oaocc.enhanced, oaocc.superpixels, LabelMap(s)(oaocc.r1.rect()).clone(),
+        OcclusionFeaturesOnCrop(OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows),
+                                oaocc)};
     auto samples = ExtractOcclusionSamples(frame, params, static_cast<std::size_t>(i));
     if (!samples.ok()) return samples.status();
     per_frame[i] = std::move(*samples);
