@@ -25,6 +25,7 @@ Runner AddTrainCommand(CLI::App& app) {
     int trees = 200;
     double negatives_scale = 1.0;
     std::string on_bad_frame = "fail";
+    std::string fold_layout = "blocks";
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("train", "train a model bundle from a dataset's train split");
@@ -120,6 +121,12 @@ Runner AddTrainCommand(CLI::App& app) {
       "train each learned part on maps of the final classifiers, which have seen those frames "
       "(the paper's training; default: maps from classifiers trained on the other of two folds "
       "of frames, as a new frame's)");
+  cmd->add_option("--fold-layout", args->fold_layout,
+                  "how frames are dealt into the two folds of the out-of-fold maps and the score "
+                  "calibration: blocks (each fold one run of consecutive frames, so a frame's "
+                  "neighbours in its drive stay out of the copy that maps it; the default) or "
+                  "alternate (in turn, the earlier recipe)")
+      ->check(CLI::IsMember({"blocks", "alternate"}));
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,
@@ -127,6 +134,7 @@ Runner AddTrainCommand(CLI::App& app) {
   return [args] {
     TrainOptions options = args->train;
     options.on_bad_frame = *ParseBadFramePolicy(args->on_bad_frame);  // checked by CLI11
+    options.fold_layout = *ParseFoldLayout(args->fold_layout);        // checked by CLI11
     if (!options.sed_model.empty() && options.edge_source != "sed") options.edge_source = "sed";
     options.regressor.num_trees = args->trees;
     for (std::vector<int>* counts :

@@ -14,6 +14,7 @@
 #include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/parallel.h"
 #include "core/pipeline/probability_map.h"
+#include "core/pipeline/training_folds.h"
 #include "core/proposals/ground_plane_size_prior.h"
 
 namespace tod {
@@ -277,7 +278,8 @@ std::vector<int> ClassifierFrames(const TrainingRun& run, const Survey& survey) 
 // maps (the occlusion classifier from edge maps, the regressors from occlusion maps and edge
 // features) learns from the wrong distribution. Stacked training: each learned part also gets a
 // copy trained on each of two folds of frames, and a frame's maps for the next part come from the
-// copy trained on the other fold, as they would on a frame never seen.
+// copy trained on the other fold, as they would on a frame never seen. The folds are runs of
+// whole drives by default (TrainOptions::fold_layout, training_folds.h).
 constexpr int kFolds = 2;
 
 constexpr char kFewFramesHint[] =
@@ -286,22 +288,13 @@ constexpr char kFewFramesHint[] =
 
 struct ClassifierFolds {
   bool enabled = false;
-  // Fold of every frame position. The classifier frames alternate between the folds in their own
-  // order (they are every k-th usable frame, so position parity could put them all in one fold);
-  // the other usable frames, which no classifier saw, alternate in theirs.
-  std::vector<int> fold_of;
+  std::vector<int> fold_of;  // fold of every frame position (AssignFolds)
   // upstream[f]: the bundle's parameters with the classifiers trained on fold f's frames.
   std::array<ModelBundle, kFolds> upstream;
 
   ClassifierFolds(bool on, int num_frames, const std::vector<int>& usable,
-                  const std::vector<int>& classifier_frames)
-      : enabled(on), fold_of(num_frames, -1) {
-    int next = 0;
-    for (int i : classifier_frames) fold_of[i] = next++ % kFolds;
-    next = 0;
-    for (int i : usable)
-      if (fold_of[i] < 0) fold_of[i] = next++ % kFolds;
-  }
+                  const std::vector<int>& classifier_frames, FoldLayout layout)
+      : enabled(on), fold_of(AssignFolds(num_frames, usable, classifier_frames, kFolds, layout)) {}
   int FoldOf(int frame) const { return fold_of[frame]; }
   // The bundle whose classifiers compute frame `i`'s maps for a downstream part.
   const ModelBundle& For(const ModelBundle& bundle, int frame) const {
@@ -465,6 +458,7 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
                         {"frames", which.size()},
                         {"contour_pairs", positives},
                         {"edge_maps", folds.enabled ? "out_of_fold" : "in_sample"},
+                        {"fold_layout", FoldLayoutName(options.fold_layout)},
                         {"prior_odds", bundle.params.prior_correction.occlusion_odds},
                         {"trees", params.forest.num_trees},
                         {"negatives_per_positive", params.negatives_per_positive}};
@@ -697,6 +691,7 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
   parts["calibration"] = {{"learned", true},
                           {"trained", true},
                           {"folds", kFolds},
+                          {"fold_layout", FoldLayoutName(run.options().fold_layout)},
                           {"components", fitted->samples},
                           {"on_obstacles", fitted->positives}};
   return Status::Ok();
@@ -734,7 +729,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   run.EndStep("survey");
 
   ClassifierFolds folds(options.out_of_fold_maps, run.num_frames(), survey->usable,
-                        ClassifierFrames(run, *survey));
+                        ClassifierFrames(run, *survey), options.fold_layout);
   if (folds.enabled) folds.upstream.fill(bundle);  // parameters, geometry; classifiers below
 
   run.StartStep();
@@ -764,7 +759,8 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
         {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"},
         {"negatives_per_range", std::string(name) == "ordr" ? options.selection.ordr_negatives
                                                             : options.selection.obdr_negatives},
-        {"maps", folds.enabled ? "out_of_fold" : "in_sample"}};
+        {"maps", folds.enabled ? "out_of_fold" : "in_sample"},
+        {"fold_layout", FoldLayoutName(options.fold_layout)}};
 
   run.StartStep();
   run.Say("calibrating obstacle scores (2-fold)");

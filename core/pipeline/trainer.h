@@ -16,6 +16,7 @@
 #include "core/forest/random_forest.h"
 #include "core/pipeline/bad_frames.h"
 #include "core/pipeline/model_bundle.h"
+#include "core/pipeline/training_folds.h"
 
 namespace tod {
 
@@ -68,6 +69,9 @@ struct TrainOptions {
   // they are as clean as a new frame's, not as a memorised one's. false: the final classifiers'
   // maps of frames they have seen (the paper's training).
   bool out_of_fold_maps = true;
+  // How the frames are dealt into those folds and the calibration's (training_folds.h): runs of
+  // whole drives (the default; README "Real frames") or in turn.
+  FoldLayout fold_layout = FoldLayout::kSequenceBlocks;
   std::function<void(const std::string&)> progress;  // one line per step
 };
 

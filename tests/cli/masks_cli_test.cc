@@ -289,6 +289,28 @@ TEST_F(MasksCliTest, OutOfFoldMapsByDefaultInSampleOnRequest) {
     EXPECT_NE(m["files"][file]["fnv1a64"], p["files"][file]["fnv1a64"]) << file;
 }
 
+// The folds are runs of consecutive frames by default; --fold-layout alternate deals them in turn
+// (the earlier recipe). The manifest says which, the parts fed by the fold copies differ, and an
+// unknown layout is refused before any work.
+TEST_F(MasksCliTest, FoldLayoutIsBlocksByDefaultAlternateOnRequest) {
+  const std::string blocks = (out_ / "blocks").string(), alternate = (out_ / "alternate").string();
+  const CommandResult blocks_run = RunCommand(Train(blocks));
+  ASSERT_EQ(blocks_run.exit_code, 0) << blocks_run.output;
+  const CommandResult alternate_run = RunCommand(Train(alternate, "--fold-layout alternate"));
+  ASSERT_EQ(alternate_run.exit_code, 0) << alternate_run.output;
+  const nlohmann::json b = Manifest(blocks), a = Manifest(alternate);
+  for (const char* part : {"occlusion", "ordr", "obdr", "calibration"}) {
+    EXPECT_EQ(b["training"]["parts"][part]["fold_layout"], "blocks") << part;
+    EXPECT_EQ(a["training"]["parts"][part]["fold_layout"], "alternate") << part;
+  }
+  EXPECT_EQ(b["files"]["edges.bin"]["fnv1a64"], a["files"]["edges.bin"]["fnv1a64"]);
+  EXPECT_NE(b["files"]["occlusion.bin"]["fnv1a64"], a["files"]["occlusion.bin"]["fnv1a64"]);
+  const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), "--fold-layout random"));
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_NE(wrong.output.find("fold-layout"), std::string::npos) << wrong.output;
+  EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
+}
+
 TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
   // A copy of the dataset with one corrupt test image.
   const fs::path copy = out_ / "data";

@@ -1,0 +1,33 @@
+#include "core/pipeline/training_folds.h"
+
+namespace tod {
+
+Result<FoldLayout> ParseFoldLayout(const std::string& name) {
+  if (name == "blocks") return FoldLayout::kSequenceBlocks;
+  if (name == "alternate") return FoldLayout::kAlternate;
+  return Status::InvalidArgument("--fold-layout must be blocks or alternate, got '" + name + "'");
+}
+
+const char* FoldLayoutName(FoldLayout layout) {
+  return layout == FoldLayout::kSequenceBlocks ? "blocks" : "alternate";
+}
+
+std::vector<int> AssignFolds(int num_frames, const std::vector<int>& usable,
+                             const std::vector<int>& classifier_frames, int folds,
+                             FoldLayout layout) {
+  std::vector<int> fold_of(static_cast<std::size_t>(num_frames), -1);
+  if (folds < 1) return fold_of;
+  if (layout == FoldLayout::kSequenceBlocks) {
+    const long long n = static_cast<long long>(usable.size());
+    for (long long j = 0; j < n; ++j) fold_of[usable[j]] = static_cast<int>(j * folds / n);
+    return fold_of;
+  }
+  int next = 0;
+  for (int i : classifier_frames) fold_of[i] = next++ % folds;
+  next = 0;
+  for (int i : usable)
+    if (fold_of[i] < 0) fold_of[i] = next++ % folds;
+  return fold_of;
+}
+
+}  // namespace tod
