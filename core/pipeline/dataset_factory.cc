@@ -62,6 +62,7 @@ Result<FrameSelection> SelectFrames(const DatasetSpec& spec) {
   if (total == 0)
     return Status::InvalidArgument(spec.root + ": the " + spec.split + " split is empty");
   out.frames = SpreadIndices(total, spec.max_frames);
+  out.source.assign(out.frames.size(), 0);
   return out;
 }
 
@@ -107,6 +108,8 @@ Result<FrameSelection> SelectFrames(const std::vector<DatasetSpec>& specs) {
   }
   FrameSelection out;
   out.format = formats;
+  for (std::size_t p = 0; p < parts.size(); ++p)
+    out.source.insert(out.source.end(), parts[p].frames.size(), static_cast<int>(p));
   out.dataset = std::make_unique<ConcatenatedDataset>(std::move(parts));
   for (int i = 0; i < static_cast<int>(out.dataset->size()); ++i) out.frames.push_back(i);
   return out;

@@ -32,6 +32,9 @@ struct FrameSelection {
   std::unique_ptr<Dataset> dataset;
   std::string format;       // resolved: "laf", "masks" or "modd2"
   std::vector<int> frames;  // indices into dataset, ascending, never empty
+  // Per entry of `frames`: which of the datasets it comes from (all 0 for one dataset), so that
+  // whatever follows a dataset's order (training_folds.h) can stay within it.
+  std::vector<int> source;
 };
 Result<FrameSelection> SelectFrames(const DatasetSpec& spec);
 // Several datasets as one (e.g. synthetic scenes and real frames): their selections in order;

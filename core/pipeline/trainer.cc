@@ -72,6 +72,8 @@ class TrainingRun {
     return Status::Ok();
   }
   std::string FrameName(int position) const { return selection_.dataset->name(frames_[position]); }
+  // Which of the datasets (data_root, then more_data) each frame position comes from.
+  const std::vector<int>& FrameSources() const { return selection_.source; }
 
   const TrainOptions& options() const { return options_; }
   const std::string& format() const { return selection_.format; }
@@ -293,8 +295,10 @@ struct ClassifierFolds {
   std::array<ModelBundle, kFolds> upstream;
 
   ClassifierFolds(bool on, int num_frames, const std::vector<int>& usable,
-                  const std::vector<int>& classifier_frames, FoldLayout layout)
-      : enabled(on), fold_of(AssignFolds(num_frames, usable, classifier_frames, kFolds, layout)) {}
+                  const std::vector<int>& classifier_frames, FoldLayout layout,
+                  const std::vector<int>& source)
+      : enabled(on),
+        fold_of(AssignFolds(num_frames, usable, classifier_frames, kFolds, layout, source)) {}
   int FoldOf(int frame) const { return fold_of[frame]; }
   // The bundle whose classifiers compute frame `i`'s maps for a downstream part.
   const ModelBundle& For(const ModelBundle& bundle, int frame) const {
@@ -729,7 +733,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   run.EndStep("survey");
 
   ClassifierFolds folds(options.out_of_fold_maps, run.num_frames(), survey->usable,
-                        ClassifierFrames(run, *survey), options.fold_layout);
+                        ClassifierFrames(run, *survey), options.fold_layout, run.FrameSources());
   if (folds.enabled) folds.upstream.fill(bundle);  // parameters, geometry; classifiers below
 
   run.StartStep();

@@ -1,5 +1,7 @@
 #include "core/pipeline/training_folds.h"
 
+#include <map>
+
 namespace tod {
 
 Result<FoldLayout> ParseFoldLayout(const std::string& name) {
@@ -14,12 +16,16 @@ const char* FoldLayoutName(FoldLayout layout) {
 
 std::vector<int> AssignFolds(int num_frames, const std::vector<int>& usable,
                              const std::vector<int>& classifier_frames, int folds,
-                             FoldLayout layout) {
+                             FoldLayout layout, const std::vector<int>& source) {
   std::vector<int> fold_of(static_cast<std::size_t>(num_frames), -1);
   if (folds < 1) return fold_of;
   if (layout == FoldLayout::kSequenceBlocks) {
-    const long long n = static_cast<long long>(usable.size());
-    for (long long j = 0; j < n; ++j) fold_of[usable[j]] = static_cast<int>(j * folds / n);
+    std::map<int, std::vector<int>> by_source;  // usable positions of each dataset, in order
+    for (int i : usable) by_source[source.empty() ? 0 : source[i]].push_back(i);
+    for (const auto& [dataset, positions] : by_source) {
+      const long long n = static_cast<long long>(positions.size());
+      for (long long j = 0; j < n; ++j) fold_of[positions[j]] = static_cast<int>(j * folds / n);
+    }
     return fold_of;
   }
   int next = 0;

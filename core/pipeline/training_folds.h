@@ -22,12 +22,14 @@ Result<FoldLayout> ParseFoldLayout(const std::string& name);
 const char* FoldLayoutName(FoldLayout layout);
 
 // The fold (0 .. folds-1) of every frame position in [0, num_frames); -1 for positions that are
-// not in `usable`. kSequenceBlocks: the usable positions in order, cut into `folds` runs as even
-// as possible. kAlternate: the classifier frames dealt in turn in their own order (they are every
-// k-th usable frame, so dealing by position could put them all in one fold), then the other
-// usable frames in theirs.
+// not in `usable`. source[i]: the dataset position i comes from (empty: one dataset).
+// kSequenceBlocks: each dataset's usable positions in order, cut into `folds` runs as even as
+// possible, so that with several datasets (`tod train --add-data`) every fold holds part of each
+// rather than one fold one dataset. kAlternate: the classifier frames dealt in turn in their own
+// order (they are every k-th usable frame, so dealing by position could put them all in one fold),
+// then the other usable frames in theirs.
 std::vector<int> AssignFolds(int num_frames, const std::vector<int>& usable,
                              const std::vector<int>& classifier_frames, int folds,
-                             FoldLayout layout);
+                             FoldLayout layout, const std::vector<int>& source = {});
 
 }  // namespace tod

@@ -311,6 +311,19 @@ TEST_F(MasksCliTest, FoldLayoutIsBlocksByDefaultAlternateOnRequest) {
   EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
 }
 
+// Two datasets trained together: the folds cut each into runs of its own (training_folds.h), and
+// the manifest names both.
+TEST_F(MasksCliTest, AddDataTrainsOnBothDatasetsWithFoldsInEach) {
+  const std::string model = (out_ / "two").string();
+  const CommandResult run = RunCommand(Train(model, "--add-data " + Root()));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json m = Manifest(model);
+  ASSERT_TRUE(m["training"]["data"].is_array());
+  EXPECT_EQ(m["training"]["data"].size(), 2u);
+  EXPECT_EQ(m["training"]["parts"]["ordr"]["fold_layout"], "blocks");
+  EXPECT_EQ(m["training"]["parts"]["ordr"]["maps"], "out_of_fold");
+}
+
 TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
   // A copy of the dataset with one corrupt test image.
   const fs::path copy = out_ / "data";

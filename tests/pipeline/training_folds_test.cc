@@ -17,6 +17,16 @@ TEST(AssignFoldsTest, BlocksCutTheUsableFramesIntoConsecutiveRuns) {
   EXPECT_EQ(three, (std::vector<int>{0, 0, 1, -1, 1, 2, 2}));
 }
 
+// With several datasets (tod train --add-data), each is cut into runs of its own: one fold per
+// dataset would train every copy on one domain only.
+TEST(AssignFoldsTest, BlocksCutEachDatasetSeparately) {
+  const std::vector<int> usable = {0, 1, 2, 3, 4, 5, 6, 7};
+  const std::vector<int> source = {0, 0, 0, 0, 1, 1, 1, 1};
+  const std::vector<int> folds =
+      AssignFolds(8, usable, usable, 2, FoldLayout::kSequenceBlocks, source);
+  EXPECT_EQ(folds, (std::vector<int>{0, 0, 1, 1, 0, 0, 1, 1}));
+}
+
 // Alternate: the classifier frames in turn, then the others in turn (the earlier recipe).
 TEST(AssignFoldsTest, AlternateDealsClassifierFramesThenTheRestInTurn) {
   const std::vector<int> usable = {0, 1, 2, 3, 4, 5};
