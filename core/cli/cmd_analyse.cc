@@ -28,6 +28,7 @@ Runner AddAnalyseCommand(CLI::App& app) {
   cmd->add_option("--threads", args->analysis.threads, "worker threads (0 = all cores)");
   cmd->add_option("--json", args->json, "write every obstacle's fate and frame's counts here");
   return [args] {
+    BoundOpenCvThreads(args->analysis.threads);
     auto bundle = LoadModelBundle(args->model);
     if (!bundle.ok()) return Fail(bundle.status().message());
     LossAnalysisOptions options = args->analysis;

@@ -37,6 +37,7 @@ Runner AddEvalCommand(CLI::App& app) {
   cmd->add_flag("--record", args->record,
                 "store the numbers in the bundle's manifest.json (its own eval numbers)");
   return [args] {
+    BoundOpenCvThreads(args->eval.threads);
     auto bundle = LoadModelBundle(args->model);
     if (!bundle.ok()) return Fail(bundle.status().message());
     EvalOptions options = args->eval;

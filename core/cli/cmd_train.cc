@@ -132,6 +132,7 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--eval-frames", args->eval_frames,
                   "evaluate on at most this many frames (0 = all)");
   return [args] {
+    BoundOpenCvThreads(args->train.threads);
     TrainOptions options = args->train;
     options.on_bad_frame = *ParseBadFramePolicy(args->on_bad_frame);  // checked by CLI11
     options.fold_layout = *ParseFoldLayout(args->fold_layout);        // checked by CLI11

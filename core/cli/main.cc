@@ -1,6 +1,7 @@
 // tod: synthesise data, train a model bundle, detect obstacles, evaluate (ALGORITHM.md).
 #include <iostream>
 #include <map>
+#include <opencv2/core/utility.hpp>
 
 #include "core/base/heap_tuning.h"
 #include "core/cli/commands.h"
@@ -10,6 +11,10 @@ namespace tod::cli {
 int Fail(const std::string& message) {
   std::cerr << "tod: " << message << "\n";
   return 1;
+}
+
+void BoundOpenCvThreads(int threads) {
+  if (threads > 0) cv::setNumThreads(threads);
 }
 
 }  // namespace tod::cli

@@ -1,15 +1,21 @@
 // `tod train` streams frames (issue 10, §4): its memory must not grow with the number of frames.
-// Two trainings on the same synthetic set, one on N frames and one on 4N, each in its own `tod
+// Two trainings on the same synthetic set, one on N frames and one on 12N, each in its own `tod
 // train` process (so nothing this test process or an earlier test allocated is counted), compare
 // their peak resident sets. What may grow with the frames by design is small: the regressors keep
 // about 300 sampled proposals of 20 features per frame (about 25 KB), and their forests grow with
 // those samples. What must not grow is anything of the size of a frame: a trainer that kept the
-// images (or any per-frame map) of the 3N extra frames would add at least 3N * 0.6 MB = 14 MB
-// here, which is what the bound below refuses. (A ratio of the two runs' growths over the
-// program's start would not do: one frame's working set, some 30 MB, dominates both.)
+// images (or any per-frame map) of the 11N extra frames would add at least 11N * 0.6 MB = 52 MB
+// here, twice what the bound below allows. (A ratio of the two runs' growths over the program's
+// start would not do: one frame's working set, some 30 MB, dominates both.)
 //
-// Not timing-dependent: one worker thread (no frames in flight together), fixed seeds, and the
-// figures are the trainer's own VmHWM readings (core/base/memory_usage.h) from its log.
+// Why 12N and not fewer: the peak also moves with where the heap's retained blocks happen to fall
+// (heap_tuning.h keeps freed blocks), which depends on the frames and on the models trained so
+// far, not on their number: on this set 8, 16, 32, 64 and 96 frames peaked at 87, 85, 101, 88
+// and 87 MB. That spread, up to 15 MB, must stay well inside the bound (26 MB).
+//
+// Not timing-dependent: `--threads 1` is one thread, OpenCV's loops included (the CLI bounds
+// them, commands.h), fixed seeds, and the figures are the trainer's own VmHWM readings
+// (core/base/memory_usage.h) from its log: the same on a busy machine as on an idle one.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -28,10 +34,10 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int kSmallFrames = 8;
-constexpr int kLargeFrames = 4 * kSmallFrames;
-// Small frames, many of them: the peak's spread from one frame selection to another (the
-// heaviest frame's working set, where the heap's blocks happen to fall) is about 2 MB here and
-// grows with the frame size, while what kept frames would add grows with their number.
+constexpr int kLargeFrames = 12 * kSmallFrames;
+// Small frames, many of them: the peak's spread (the heaviest frame's working set, where the
+// heap's blocks happen to fall) grows with the frame size, while what kept frames would add grows
+// with their number.
 constexpr int kWidth = 640;
 constexpr int kHeight = 320;
 constexpr double kImageMb = kWidth * kHeight * 3 / (1024.0 * 1024.0);
@@ -67,12 +73,10 @@ class TrainMemoryTest : public ::testing::Test {
     const fs::path model = out_ / ("model_" + std::to_string(frames));
     // Both runs work on the same regions (laf2020, scaled to the frame), so a frame costs the
     // same working memory in either; derived regions would follow each run's obstacles.
-    // OPENCV_FOR_THREADS_NUM=1: OpenCV's own loops on the calling thread too, so the allocator
-    // sees one thread whatever the machine.
     const tod::testing_env::CommandResult run = tod::testing_env::RunCommand(
-        "OPENCV_FOR_THREADS_NUM=1 " + tod_ + " train --data " + (out_ / "data").string() +
-        " --out " + model.string() + " --max-frames " + std::to_string(frames) +
-        " --classifier-frames " + std::to_string(kSmallFrames) +
+        tod_ + " train --data " + (out_ / "data").string() + " --out " + model.string() +
+        " --max-frames " + std::to_string(frames) + " --classifier-frames " +
+        std::to_string(kSmallFrames) +
         " --regions laf2020 --trees 8 --threads 1 --seed 3 --no-eval");
     TrainingMemory memory;
     memory.log = run.output;
