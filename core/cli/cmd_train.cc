@@ -127,6 +127,10 @@ Runner AddTrainCommand(CLI::App& app) {
                   "neighbours in its drive stay out of the copy that maps it; the default) or "
                   "alternate (in turn, the earlier recipe)")
       ->check(CLI::IsMember({"blocks", "alternate"}));
+  cmd->add_flag("--fit-map-isolation,!--no-map-isolation", args->train.fit_map_isolation,
+                "weight each box of the probability map by how isolated it is among the frame's "
+                "best boxes, to the power fitted on the calibration's out-of-fold maps (the "
+                "default; --no-map-isolation: the paper's map)");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,

@@ -22,8 +22,10 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeBoxParams, alpha, beta, min_
                                                 min_stride, refine, refine_limit,
                                                 refine_local_maxima)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FusionParams, beta1, keep_ratio)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BoxIsolationParams, exponent, context_boxes,
+                                                surround)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score, nms_iou, max_boxes,
-                                                top_fraction)
+                                                top_fraction, isolation)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PriorCorrection, edge_odds, occlusion_odds)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ForestScreening, trees, final_at_most)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ObstacleCalibration, fitted, slope, intercept,
@@ -60,6 +62,11 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
   if (p.regions.num_layers < 1 || p.superpixels.k < 1 || p.fusion.keep_ratio < 0 ||
       p.fusion.keep_ratio > 1 || p.probability_map.top_fraction < 0 ||
       p.probability_map.top_fraction > 1 || !(p.region_merge_iou > 0 && p.region_merge_iou <= 1) ||
+      !(p.probability_map.isolation.exponent >= 0 &&
+        std::isfinite(p.probability_map.isolation.exponent)) ||
+      p.probability_map.isolation.context_boxes < 1 ||
+      !(p.probability_map.isolation.surround >= 1 &&
+        std::isfinite(p.probability_map.isolation.surround)) ||
       !(p.prior_correction.edge_odds > 0) || !(p.prior_correction.occlusion_odds > 0) ||
       p.edge_screening.trees < 0 ||
       !(p.edge_screening.final_at_most >= 0 && p.edge_screening.final_at_most < 1) ||
@@ -69,6 +76,7 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
     return Status::InvalidArgument(
         "parameters out of range (regions.num_layers, superpixels.k, fusion.keep_ratio, "
         "probability_map.top_fraction, region_merge_iou in (0, 1], prior_correction > 0, "
+        "probability_map.isolation: exponent >= 0, context_boxes >= 1, surround >= 1, "
         "edge_screening / occlusion_screening: trees >= 0, final_at_most in [0, 1), "
         "box_features.horizon_y and occlusion_features.horizon_y finite)");
   return p;

@@ -51,7 +51,11 @@ float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_b
 
 cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
                                    const ProbabilityMapParams& params) {
-  const std::vector<ScoredBox> kept = MapBoxes(boxes, params);
+  std::vector<ScoredBox> kept = MapBoxes(boxes, params);
+  if (params.isolation.exponent != 0.f) {
+    const std::vector<float> weights = IsolationWeights(kept, boxes, params.isolation);
+    for (std::size_t i = 0; i < kept.size(); ++i) kept[i].score *= weights[i];
+  }
   const std::size_t top = kept.size();
   // 2-D difference image: +s at the box's top-left, -s past its right / bottom, prefix sums.
   cv::Mat1d diff = cv::Mat1d::zeros(image_size.height + 1, image_size.width + 1);

@@ -6,6 +6,7 @@
 
 #include "core/base/types.h"
 #include "core/edges/sticky_superpixels.h"
+#include "core/pipeline/box_isolation.h"
 #include "core/pipeline/obstacle_calibration.h"
 
 namespace tod {
@@ -28,6 +29,9 @@ struct ProbabilityMapParams {
   float nms_iou = 0.7f;
   int max_boxes = 1000;
   float top_fraction = 0.5f;  // the top half of the kept boxes is accumulated
+  // Each accumulated box's score times its isolation weight (box_isolation.h); exponent 0, the
+  // default and the paper's map, leaves the scores as they are. `tod train` fits the exponent.
+  BoxIsolationParams isolation;
 };
 
 // Score-sorted boxes with score > min_score (before NMS): the ranked list used for instance
@@ -44,7 +48,8 @@ std::vector<ScoredBox> MapBoxes(const std::vector<ScoredBox>& boxes,
 float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_boxes);
 
 // §7 steps 2-5: threshold, NMS, top fraction, accumulate per pixel (difference image + prefix
-// sums, so the cost is linear in boxes plus pixels), normalise by the maximum.
+// sums, so the cost is linear in boxes plus pixels), normalise by the maximum. With an isolation
+// exponent, each accumulated box adds its score times its isolation weight among `boxes`.
 cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
                                    const ProbabilityMapParams& params = {});
 

@@ -3,6 +3,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <limits>
 #include <mutex>
 #include <optional>
 
@@ -11,6 +12,7 @@
 #include "core/pipeline/dataset_factory.h"
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
+#include "core/pipeline/map_isolation_fit.h"
 #include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/parallel.h"
 #include "core/pipeline/probability_map.h"
@@ -636,15 +638,19 @@ Result<TrainedRegressors> TrainRegressors(TrainingRun& run, const Survey& survey
   return TrainedRegressors{std::move(*mined), std::move(*second)};
 }
 
-// Calibration of the obstacles' scores (obstacle_calibration.h). The regressors fit their own
-// training frames closely, so scores on those frames would be overconfident: each frame is
-// scored by regressors trained on the other fold of frames (2-fold cross-fitting), then Platt
-// scaling of "covers an obstacle pixel" on the evidence of every component found.
+// Calibration of the obstacles' scores (obstacle_calibration.h) and the map's isolation exponent
+// (map_isolation_fit.h), from one out-of-fold pass. The regressors fit their own training frames
+// closely, so scores on those frames would be overconfident: each frame is scored by regressors
+// trained on the other fold of frames (2-fold cross-fitting). The exponent whose map ranks those
+// frames' obstacle pixels best is chosen, then Platt scaling of "covers an obstacle pixel" is
+// fitted on the evidence of every component that map yields.
 Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
                                const RegressorSamples& samples, const ClassifierFolds& folds,
                                ModelBundle& bundle, nlohmann::json& parts) {
   const auto fold_of = [&folds](int frame) { return folds.FoldOf(frame); };
-  std::vector<std::vector<std::pair<double, int>>> per_frame(run.num_frames());
+  MapIsolationFit isolation(
+      run.options().fit_map_isolation ? DefaultIsolationExponents() : std::vector<float>{0.f},
+      bundle.params, run.num_frames());
   for (int fold = 0; fold < kFolds; ++fold) {
     std::vector<int> which;
     for (int i : survey.usable)
@@ -660,23 +666,32 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
     fold_bundle.obdr = std::move(pair->obdr);
     const ObstacleDetector detector(std::move(fold_bundle), "calibration");
     DetectOptions options;
-    options.min_obstacle_score = -1.f;  // every component
+    options.max_proposals = std::numeric_limits<int>::max();  // the map's input: every box
     options.want_probability_map = false;
     const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
       auto detection = detector.Detect(s.image, options);
       if (!detection.ok()) return detection.status();
-      for (const DetectedObstacle& o : detection->obstacles) {
-        const bool on_obstacle = cv::countNonZero(s.obstacle(o.box.rect())) > 0;
-        per_frame[i].emplace_back(o.evidence, on_obstacle ? 1 : 0);
-      }
-      return Status::Ok();
+      std::vector<ScoredBox> fused;
+      fused.reserve(detection->proposals.size());
+      for (const Proposal& p : detection->proposals) fused.push_back({p.box, p.fused});
+      return isolation.AddFrame(i, s, fused);
     }));
     if (!st.ok()) return st.WithContext("calibrating obstacle scores");
   }
+  const int chosen = isolation.Best();
+  bundle.params.probability_map.isolation.exponent = isolation.exponent(chosen);
+  parts["map_isolation"] = {{"learned", true},
+                            {"trained", true},
+                            {"fit", run.options().fit_map_isolation},
+                            {"folds", kFolds},
+                            {"fold_layout", FoldLayoutName(run.options().fold_layout)}};
+  parts["map_isolation"].update(isolation.ToJson());
+  run.Say("map isolation exponent " + std::to_string(isolation.exponent(chosen)));
+
   std::vector<double> evidence;
   std::vector<int> labels;
-  for (const auto& frame : per_frame)
-    for (const auto& [e, label] : frame) evidence.push_back(e), labels.push_back(label);
+  for (const auto& [e, label] : isolation.Components(chosen))
+    evidence.push_back(e), labels.push_back(label);
   auto fitted = FitObstacleCalibration(evidence, labels);
   if (!fitted.ok()) {
     // Not an untrained learned part but data without the contrast to fit (e.g. a handful of
@@ -688,6 +703,7 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
     parts["calibration"] = {{"learned", true},
                             {"trained", false},
                             {"reason", fitted.status().message()},
+                            {"fold_layout", FoldLayoutName(run.options().fold_layout)},
                             {"components", evidence.size()}};
     return Status::Ok();
   }
@@ -767,7 +783,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
         {"fold_layout", FoldLayoutName(options.fold_layout)}};
 
   run.StartStep();
-  run.Say("calibrating obstacle scores (2-fold)");
+  run.Say("calibrating obstacle scores and fitting the map's isolation (2-fold)");
   if (Status st = CalibrateObstacleScores(run, *survey, samples, folds, bundle, parts); !st.ok())
     return st;
   run.EndStep("calibration");

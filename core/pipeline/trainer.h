@@ -72,6 +72,9 @@ struct TrainOptions {
   // How the frames are dealt into those folds and the calibration's (training_folds.h): runs of
   // whole drives (the default; README "Real frames") or in turn.
   FoldLayout fold_layout = FoldLayout::kSequenceBlocks;
+  // The probability map's isolation exponent (box_isolation.h; not in the paper): fitted on the
+  // calibration's out-of-fold maps (map_isolation_fit.h). false: 0, the paper's map.
+  bool fit_map_isolation = true;
   std::function<void(const std::string&)> progress;  // one line per step
 };
 

@@ -311,6 +311,57 @@ TEST_F(MasksCliTest, FoldLayoutIsBlocksByDefaultAlternateOnRequest) {
   EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
 }
 
+// The map's isolation exponent (box_isolation.h) is fitted by default on the calibration's
+// out-of-fold maps: the manifest lists every candidate with its AP and the winner, which is the
+// exponent the bundle's parameters carry. --no-map-isolation keeps the paper's map.
+TEST_F(MasksCliTest, MapIsolationIsFittedByDefaultPaperMapOnRequest) {
+  const std::string fitted = (out_ / "fitted").string(), paper = (out_ / "paper").string();
+  const CommandResult fitted_run = RunCommand(Train(fitted));
+  ASSERT_EQ(fitted_run.exit_code, 0) << fitted_run.output;
+  const CommandResult paper_run = RunCommand(Train(paper, "--no-map-isolation"));
+  ASSERT_EQ(paper_run.exit_code, 0) << paper_run.output;
+
+  const nlohmann::json f = Manifest(fitted);
+  const nlohmann::json& part = f["training"]["parts"]["map_isolation"];
+  EXPECT_EQ(part["trained"], true);
+  EXPECT_EQ(part["fit"], true);
+  ASSERT_EQ(part["candidates"].size(), 6u) << part;
+  double best_ap = -1, best_exponent = -1;
+  for (const nlohmann::json& c : part["candidates"])
+    if (c["ap"].is_number() && c["ap"].get<double>() > best_ap)
+      best_ap = c["ap"].get<double>(), best_exponent = c["exponent"].get<double>();
+  ASSERT_GE(best_exponent, 0) << part;
+  EXPECT_DOUBLE_EQ(part["exponent"].get<double>(), best_exponent);
+  EXPECT_DOUBLE_EQ(f["params"]["probability_map"]["isolation"]["exponent"].get<double>(),
+                   best_exponent);
+
+  const nlohmann::json p = Manifest(paper);
+  EXPECT_EQ(p["training"]["parts"]["map_isolation"]["fit"], false);
+  EXPECT_EQ(p["training"]["parts"]["map_isolation"]["candidates"].size(), 1u);
+  EXPECT_EQ(p["params"]["probability_map"]["isolation"]["exponent"].get<double>(), 0.0);
+  // The regressors do not depend on the map: the same forests either way.
+  EXPECT_EQ(f["files"]["ordr.bin"]["fnv1a64"], p["files"]["ordr.bin"]["fnv1a64"]);
+
+  // `tod detect` serves the map of the bundle's exponent: the same bundle with the paper's map
+  // and with isolation to the 4th power give different maps of the same frame.
+  const std::string image = Root() + "/images/2.png";  // a frame of the set, with obstacles
+  cv::Mat maps[2];
+  for (const int exponent : {0, 4}) {
+    const fs::path copy = out_ / ("exponent_" + std::to_string(exponent));
+    fs::copy(paper, copy, fs::copy_options::recursive);
+    nlohmann::json manifest = Manifest(copy.string());
+    manifest["params"]["probability_map"]["isolation"]["exponent"] = exponent;
+    std::ofstream(copy / "manifest.json") << manifest.dump(2);
+    const fs::path out = out_ / ("detect_" + std::to_string(exponent));
+    const CommandResult detect = RunCommand(tod_ + " detect --model " + copy.string() + " --out " +
+                                            out.string() + " " + image);
+    ASSERT_EQ(detect.exit_code, 0) << detect.output;
+    maps[exponent == 0 ? 0 : 1] = cv::imread((out / "2_prob.png").string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(maps[exponent == 0 ? 0 : 1].empty());
+  }
+  EXPECT_GT(cv::norm(maps[0], maps[1], cv::NORM_L1), 0.0);
+}
+
 // Two datasets trained together: the folds cut each into runs of its own (training_folds.h), and
 // the manifest names both.
 TEST_F(MasksCliTest, AddDataTrainsOnBothDatasetsWithFoldsInEach) {

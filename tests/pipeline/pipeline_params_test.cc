@@ -14,6 +14,7 @@ TEST(PipelineParams, DefaultsAreThePapers) {
   EXPECT_FLOAT_EQ(p.fusion.beta1, 0.3f);
   EXPECT_FLOAT_EQ(p.probability_map.nms_iou, 0.7f);
   EXPECT_TRUE(p.multistride);
+  EXPECT_FLOAT_EQ(p.probability_map.isolation.exponent, 0.f);  // the paper's map
 }
 
 TEST(PipelineParams, JsonRoundTripAndMissingKeysKeepDefaults) {
@@ -35,6 +36,16 @@ TEST(PipelineParams, WrongTypesAndRangesAreErrors) {
   EXPECT_FALSE(PipelineParamsFromJson({{"boxes", {{"alpha", "big"}}}}).ok());
   EXPECT_FALSE(PipelineParamsFromJson({{"boxes", {{"alpha", 1.5}}}}).ok());
   EXPECT_FALSE(PipelineParamsFromJson({{"fusion", {{"keep_ratio", 2}}}}).ok());
+  for (const nlohmann::json& isolation :
+       {nlohmann::json{{"exponent", -1}}, nlohmann::json{{"context_boxes", 0}},
+        nlohmann::json{{"surround", 0.5}}}) {
+    EXPECT_FALSE(PipelineParamsFromJson({{"probability_map", {{"isolation", isolation}}}}).ok())
+        << isolation;
+  }
+  auto fitted = PipelineParamsFromJson({{"probability_map", {{"isolation", {{"exponent", 2}}}}}});
+  ASSERT_TRUE(fitted.ok()) << fitted.status().ToString();
+  EXPECT_FLOAT_EQ(fitted->probability_map.isolation.exponent, 2.f);
+  EXPECT_EQ(fitted->probability_map.isolation.context_boxes, 1000);
 }
 
 }  // namespace

@@ -1,0 +1,71 @@
+#include "core/pipeline/map_isolation_fit.h"
+
+#include <cmath>
+
+#include "core/pipeline/obstacle_detector.h"
+#include "core/pipeline/probability_map.h"
+
+namespace tod {
+
+std::vector<float> DefaultIsolationExponents() { return {0.f, 0.5f, 1.f, 2.f, 3.f, 4.f}; }
+
+MapIsolationFit::MapIsolationFit(std::vector<float> exponents, const PipelineParams& params,
+                                 int frames)
+    : exponents_(std::move(exponents)),
+      params_(params),
+      pixels_(exponents_.size()),
+      components_(exponents_.size(), std::vector<std::vector<std::pair<double, int>>>(frames)) {}
+
+Status MapIsolationFit::AddFrame(int frame, const Sample& sample,
+                                 const std::vector<ScoredBox>& fused) {
+  DetectOptions every_component;
+  every_component.min_obstacle_score = -1.f;
+  for (std::size_t c = 0; c < exponents_.size(); ++c) {
+    PipelineParams params = params_;
+    params.probability_map.isolation.exponent = exponents_[c];
+    const cv::Mat1f map =
+        AccumulateProbabilityMap(fused, sample.image.size(), params.probability_map);
+    std::vector<std::pair<double, int>> found;
+    for (const DetectedObstacle& o : ScoreObstacles(map, fused, params, every_component))
+      found.emplace_back(o.evidence, cv::countNonZero(sample.obstacle(o.box.rect())) > 0 ? 1 : 0);
+    std::lock_guard lock(mutex_);
+    if (Status st = pixels_[c].Add(map, sample.obstacle, sample.road); !st.ok()) return st;
+    components_[c][frame] = std::move(found);
+  }
+  return Status::Ok();
+}
+
+int MapIsolationFit::Best() const {
+  std::lock_guard lock(mutex_);
+  int best = 0;
+  double best_ap = -1;
+  for (std::size_t c = 0; c < exponents_.size(); ++c) {
+    const double ap = pixels_[c].Ap();
+    // Strictly better only: on a tie the earlier (smaller) exponent stays. NaN (no obstacle
+    // pixel) never wins, so such data keeps the first candidate.
+    if (std::isfinite(ap) && ap > best_ap) best = static_cast<int>(c), best_ap = ap;
+  }
+  return best;
+}
+
+std::vector<std::pair<double, int>> MapIsolationFit::Components(int candidate) const {
+  std::lock_guard lock(mutex_);
+  std::vector<std::pair<double, int>> all;
+  for (const auto& frame : components_[candidate])
+    all.insert(all.end(), frame.begin(), frame.end());
+  return all;
+}
+
+nlohmann::json MapIsolationFit::ToJson() const {
+  const int best = Best();
+  nlohmann::json candidates = nlohmann::json::array();
+  std::lock_guard lock(mutex_);
+  for (std::size_t c = 0; c < exponents_.size(); ++c) {
+    const double ap = pixels_[c].Ap();
+    candidates.push_back(
+        {{"exponent", exponents_[c]}, {"ap", std::isfinite(ap) ? nlohmann::json(ap) : nullptr}});
+  }
+  return {{"candidates", candidates}, {"exponent", exponents_[best]}};
+}
+
+}  // namespace tod
