@@ -233,6 +233,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   report.frames = n - static_cast<int>(report.skipped.size());
   report.instances = recall.at("EB").instances();
   report.reported = alarms;
+  report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;
   report.free_space = road_labelled && not_obstacle
                           ? "mixed: the road label where the frame has one, else every non-void "
                             "non-obstacle pixel"
@@ -277,6 +278,7 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
                      per(a.false_alarms_on_obstacle_free, a.obstacle_free_frames)},
                     {"instances_found", per(a.instances_found, r.instances)}};
   j["free_space"] = r.free_space;
+  j["map_isolation_exponent"] = r.map_isolation_exponent;
   auto ar = [](const VariantCurves& c) {
     nlohmann::json a = nlohmann::json::object();
     for (const auto& [n, v] : c.ar_table) a[std::to_string(n)] = v;
@@ -312,6 +314,11 @@ std::string FormatEvalTables(const EvalReport& r) {
   std::ostringstream o;
   o << "frames " << r.frames << ", obstacle instances " << r.instances << "\n";
   o << "free space (FPR, AP negatives): " << r.free_space << "\n";
+  o << "paper's map: "
+    << (r.map_isolation_exponent > 0.f
+            ? "each box weighted by its isolation^" + Fixed(r.map_isolation_exponent, 1)
+            : std::string("as published (no isolation weight)"))
+    << "\n";
   {
     const ReportedObstacleCounts& a = r.reported;
     char text[256];

@@ -69,6 +69,9 @@ struct EvalReport {
   // What the pixel metrics' negatives are: "road label" (LAF free space, MODDv2 water) or
   // "every non-void pixel that is not an obstacle" (mask benchmarks without a road label).
   std::string free_space;
+  // The bundle's isolation exponent of the paper's map (box_isolation.h): the regression
+  // variants' maps weigh each box by isolation^this; 0 is the paper's map as published.
+  float map_isolation_exponent = 0.f;
   int instances = 0;
   std::map<std::string, VariantCurves> proposals;   // proposal variants
   std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)

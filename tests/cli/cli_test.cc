@@ -192,6 +192,12 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
     EXPECT_FALSE(cv::imread((out_ / "plots" / png).string()).empty()) << png;
   // The printed table carries them too.
   EXPECT_NE(run.output.find("Pixel AP and FPR at 95 % TPR"), std::string::npos) << run.output;
+  // Which map the pixel metrics were measured on: the bundle's isolation exponent.
+  std::ifstream manifest_in(fs::path(model_) / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(manifest_in);
+  EXPECT_DOUBLE_EQ(j["map_isolation_exponent"].get<double>(),
+                   manifest["params"]["probability_map"]["isolation"]["exponent"].get<double>());
+  EXPECT_NE(run.output.find("paper's map: "), std::string::npos) << run.output;
 }
 
 TEST_F(CliTest, BrokenModelIsRefusedWithTheFileNamed) {
