@@ -88,6 +88,14 @@ TEST(Mat5BoundsTest, FuzzerInputWithAZeroByteVariableIsRefusedQuickly) {
   ExpectRefusedQuickly(CorpusInput("oom-851a22babb87dacc1e4f91f49d8edd8f74101167"));
 }
 
+// A 425-byte mutated seed found by CI's 5 s fuzz_smoke: a 4 x 2 single array (a field of the
+// 'annotations' struct) whose data element's tag claims 2 GB in an 80-byte array; libmatio asked
+// calloc for 2^64 - 16 M bytes (AddressSanitizer: allocation-size-too-big), and the walk checked
+// a numeric array's dimensions but not its data tags.
+TEST(Mat5BoundsTest, FuzzerInputWithANumericDataTagClaimingAHugeSizeIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("crash-719ed68f46305663cb0bf9ae26e4260002656a5e"));
+}
+
 // The same cause, constructed: a MAT v4 header (type, rows, columns, complex flag, name length)
 // claiming a 2 GB name, followed by a few bytes.
 TEST(Mat5BoundsTest, MatV4HeaderClaimingAHugeNameIsRefused) {
