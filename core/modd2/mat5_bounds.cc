@@ -13,6 +13,7 @@ namespace {
 
 // MAT-File Level 5 data types and array classes used here (MathWorks' MAT-file format document).
 constexpr uint32_t kMiInt32 = 5;
+constexpr uint32_t kMiUint32 = 6;
 constexpr uint32_t kMiMatrix = 14;
 constexpr uint32_t kMiCompressed = 15;
 constexpr uint32_t kClassCell = 1;
@@ -120,7 +121,10 @@ class Walker {
     uint32_t type = 0, size = 0;
     std::string_view flags, dims, name;
     if (Status s = Tag(&data, &type, &size, &flags); !s.ok()) return s;
-    if (flags.size() < 4) return Corrupt("array flags too short");
+    // libmatio reads the flags as one 8-byte uint32 element whatever their tag claims, and the
+    // dimensions right after those 8 bytes: a fuzzed file whose flags tag claimed 110 bytes hid
+    // dimensions of 3 x -268 M from this walk, and libmatio allocated 48 GB for them.
+    if (type != kMiUint32 || size != 8) return Corrupt("array flags are not 8 bytes of uint32");
     const uint32_t array_class = U32(flags.data()) & 0xFF;
     if (array_class < kClassCell || array_class > kClassOpaque) {
       return Corrupt("unknown array class " + std::to_string(array_class));

@@ -96,6 +96,14 @@ TEST(Mat5BoundsTest, FuzzerInputWithANumericDataTagClaimingAHugeSizeIsRefusedQui
   ExpectRefusedQuickly(CorpusInput("crash-719ed68f46305663cb0bf9ae26e4260002656a5e"));
 }
 
+// A 425-byte mutated seed found by a 120 s run of fuzz_modd2_mat after the fix above: the struct's
+// array flags tag claims 110 bytes, so the walk took the dimensions, name and field names for
+// flags and read the rest out of step, while libmatio reads 8 bytes of flags whatever the tag says
+// and then a field's dimensions of 3 x -268 M, for which it allocated 48 GB.
+TEST(Mat5BoundsTest, FuzzerInputWithOversizedArrayFlagsIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("crash-21f975afa41a49ca7730a43deb45953b585520f0"));
+}
+
 // The same cause, constructed: a MAT v4 header (type, rows, columns, complex flag, name length)
 // claiming a 2 GB name, followed by a few bytes.
 TEST(Mat5BoundsTest, MatV4HeaderClaimingAHugeNameIsRefused) {
