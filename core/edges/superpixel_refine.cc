@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <limits>
+#include <memory>
 #include <opencv2/core/utility.hpp>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -180,6 +183,11 @@ class StickyRefiner {
     sums_[own].Add(-1.0, x, y, c);
     sums_[best].Add(1.0, x, y, c);
     if (!extents_.empty()) extents_[best].Add(y);
+    if (last_row_) {
+      // One writer per label at a time (SweepPair), so a load and a store suffice.
+      std::atomic<int>& last = last_row_[best];
+      if (last.load(std::memory_order_relaxed) < y) last.store(y, std::memory_order_relaxed);
+    }
     labels_[i] = best;
     return true;
   }
@@ -203,6 +211,10 @@ class StickyRefiner {
   // One sweep in raster order (the reference order); returns the pixels moved.
   long long SweepRaster() { return SweepRows(0, image_.height, nullptr, nullptr); }
 
+  // Two raster sweeps at once, the second a few rows behind the first, with exactly the moves of
+  // two sweeps one after the other (see RefineStickyLabels); returns the pixels each moved.
+  std::array<long long, 2> SweepPair();
+
   // One sweep in strips of strip_rows rows, the first one `shift` rows short: the even strips side
   // by side, then the odd ones, each in raster order (see RefineStickyLabels). Needs the extents
   // (ResetExtents), and keeps them.
@@ -223,12 +235,89 @@ class StickyRefiner {
   // whose rows, grown by one on each side, meet its extent.
   std::vector<char> SharedLabels(int strip_rows, int shift, int parity) const;
 
+  // A raster sweep that publishes the rows it has finished in `done`. With `ahead` (the rows the
+  // sweep before it has finished), it waits until that sweep can no longer touch what it reads.
+  long long SweepBehind(const std::atomic<int>* ahead, std::atomic<int>& done);
+  // Waits until the sweep ahead has finished `rows` rows.
+  void WaitForRows(const std::atomic<int>& ahead, int rows) const;
+  // Waits until every label the move of (x, y) reads lies above the two rows next to the sweep
+  // ahead (or that sweep is done): that sweep can then no longer read or change those labels.
+  void WaitForLabels(const std::atomic<int>& ahead, int x, int y) const;
+  // The largest last_row_ among the labels of (x, y) and its 4-neighbours.
+  int LastRowAround(int x, int y) const;
+
   const StickyImage& image_;
   const StickyWeights& weights_;
   std::vector<int>& labels_;
   std::vector<LabelSums> sums_;
   std::vector<RowExtent> extents_;  // per label, kept by SweepStrips
+  // Per label during SweepPair: a bound on the last row its pixels lie in (moves only raise it).
+  std::unique_ptr<std::atomic<int>[]> last_row_;
 };
+
+std::array<long long, 2> StickyRefiner::SweepPair() {
+  last_row_ = std::make_unique<std::atomic<int>[]>(sums_.size());
+  for (int y = 0; y < image_.height; ++y)
+    for (int x = 0; x < image_.width; ++x)
+      last_row_[labels_[static_cast<size_t>(y) * image_.width + x]].store(
+          y, std::memory_order_relaxed);
+  std::array<std::atomic<int>, 2> done{};
+  std::array<long long, 2> moved{};
+  // A task takes its sweep when it starts, so the first sweep always belongs to a running task and
+  // never waits: the pair cannot deadlock, however the pool schedules (or serialises) the tasks.
+  std::atomic<int> next{0};
+  cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& range) {
+    for (int n = range.start; n < range.end; ++n) {
+      const int sweep = next.fetch_add(1);
+      moved[sweep] = SweepBehind(sweep == 0 ? nullptr : &done[0], done[sweep]);
+    }
+  });
+  last_row_.reset();
+  return moved;
+}
+
+long long StickyRefiner::SweepBehind(const std::atomic<int>* ahead, std::atomic<int>& done) {
+  long long moved = 0;
+  for (int y = 0; y < image_.height; ++y) {
+    // OnBorder reads the row below: the sweep ahead must be past it.
+    if (ahead != nullptr) WaitForRows(*ahead, std::min(image_.height, y + 2));
+    for (int x = 0; x < image_.width; ++x) {
+      if (!OnBorder(x, y)) continue;
+      if (ahead != nullptr) WaitForLabels(*ahead, x, y);
+      moved += Move(x, y);
+    }
+    done.store(y + 1, std::memory_order_release);
+  }
+  return moved;
+}
+
+void StickyRefiner::WaitForRows(const std::atomic<int>& ahead, int rows) const {
+  while (ahead.load(std::memory_order_acquire) < rows) std::this_thread::yield();
+}
+
+void StickyRefiner::WaitForLabels(const std::atomic<int>& ahead, int x, int y) const {
+  // The sweep ahead has finished rows [0, done) and is at row `done`: its remaining moves read
+  // and write only labels with a pixel in row done - 1 or below. A label whose pixels all lie in
+  // rows <= done - 2 is not next to any pixel it has yet to visit, and a pixel only ever joins
+  // a neighbour's label, so it never reaches such a label again. The bounds it raised before
+  // finishing a row are visible once that row's `done` is (release / acquire).
+  for (;;) {
+    const int finished = ahead.load(std::memory_order_acquire);
+    if (finished >= image_.height || LastRowAround(x, y) <= finished - 2) return;
+    std::this_thread::yield();
+  }
+}
+
+int StickyRefiner::LastRowAround(int x, int y) const {
+  const size_t i = static_cast<size_t>(y) * image_.width + x;
+  const auto last = [&](size_t j) { return last_row_[labels_[j]].load(std::memory_order_relaxed); };
+  int reach = last(i);
+  if (x > 0) reach = std::max(reach, last(i - 1));
+  if (y > 0) reach = std::max(reach, last(i - image_.width));
+  if (x + 1 < image_.width) reach = std::max(reach, last(i + 1));
+  if (y + 1 < image_.height) reach = std::max(reach, last(i + image_.width));
+  return reach;
+}
 
 std::vector<char> StickyRefiner::SharedLabels(int strip_rows, int shift, int parity) const {
   std::vector<char> shared(sums_.size(), 0);
@@ -304,18 +393,30 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
   // Strips only pay off when there are several of them.
   const bool in_strips = strip_rows > 0 && height > 2 * strip_rows;
   if (in_strips) refiner.ResetExtents();
+  // The raster order with two threads: sweeps in pairs, the second one rows behind the first.
+  const bool in_pairs = !in_strips && cv::getNumThreads() > 1;
   int sweeps = 0;
-  for (int iter = 0; iter < iterations; ++iter) {
-    ++sweeps;
-    // The first sweep runs in raster order: from one label per pixel, strips started afresh at
-    // every strip border and left 5-10 % more boundary pixels on the border rows (and 2-5 % more
-    // superpixels on real frames). Later sweeps shift the strips by half a strip every other time,
-    // so that no row is always a border where the order changes.
-    const long long moved = in_strips && iter > 0
-                                ? refiner.SweepStrips(strip_rows, (iter % 2) * (strip_rows / 2))
-                                : refiner.SweepRaster();
-    if (moved == 0) break;
-    if (iter + 1 < iterations) {
+  for (int iter = 0; iter < iterations;) {
+    if (in_pairs && iter + 1 < iterations) {
+      // A sweep that moves nothing leaves the state as it found it, so the sweep after it (here
+      // its partner) moves nothing either: the count is that of sweeps one after the other.
+      const std::array<long long, 2> moved = refiner.SweepPair();
+      sweeps += moved[0] == 0 ? 1 : 2;
+      if (moved[0] == 0 || moved[1] == 0) break;
+      iter += 2;
+    } else {
+      ++sweeps;
+      // The first sweep runs in raster order: from one label per pixel, strips started afresh at
+      // every strip border and left 5-10 % more boundary pixels on the border rows (and 2-5 % more
+      // superpixels on real frames). Later sweeps shift the strips by half a strip every other
+      // time, so that no row is always a border where the order changes.
+      const long long moved = in_strips && iter > 0
+                                  ? refiner.SweepStrips(strip_rows, (iter % 2) * (strip_rows / 2))
+                                  : refiner.SweepRaster();
+      if (moved == 0) break;
+      ++iter;
+    }
+    if (iter < iterations) {
       // Compact once at least half of the labels have emptied (a pass over the labels, cheap
       // next to a sweep).
       const auto alive =

@@ -104,6 +104,33 @@ TEST_F(CliTest, DetectWritesJsonMapAndOverlay) {
     EXPECT_EQ(e.path().filename().string().find("_stage"), std::string::npos) << e.path();
 }
 
+// --threads-per-request splits a frame's work (the superpixel sweeps run in pairs, the scans,
+// features and regressors in pieces), never its result: one and two threads write the same
+// proposals, scores, obstacles and map.
+TEST_F(CliTest, DetectGivesTheSameResultOnOneAndTwoThreads) {
+  const std::string image = FirstTestImage();
+  ASSERT_FALSE(image.empty());
+  const std::string stem = fs::path(image).stem().string();
+  std::array<nlohmann::json, 2> results;
+  std::array<cv::Mat, 2> maps;
+  for (const int threads : {1, 2}) {
+    const fs::path out = out_ / ("t" + std::to_string(threads));
+    const CommandResult run = Shell(tod_ + " detect --model " + model_ + " --out " + out.string() +
+                                    " --max-proposals 100000 --threads-per-request " +
+                                    std::to_string(threads) + " " + image);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    std::ifstream in(out / (stem + ".json"));
+    results[threads - 1] = nlohmann::json::parse(in);
+    results[threads - 1].erase("timing_ms");
+    maps[threads - 1] = cv::imread((out / (stem + "_prob.png")).string(), cv::IMREAD_UNCHANGED);
+  }
+  EXPECT_GT(results[0]["proposals"].size(), 100u);
+  EXPECT_EQ(results[0], results[1]);
+  ASSERT_FALSE(maps[0].empty());
+  ASSERT_EQ(maps[0].size(), maps[1].size());
+  EXPECT_EQ(cv::countNonZero(maps[0] != maps[1]), 0);
+}
+
 TEST_F(CliTest, DetectStagesWritesEveryStageAsAFrameSizedPngAndTheCounts) {
   const std::string image = FirstTestImage();
   ASSERT_FALSE(image.empty());
