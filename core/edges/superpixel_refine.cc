@@ -6,7 +6,6 @@
 #include <limits>
 #include <memory>
 #include <opencv2/core/utility.hpp>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -287,12 +286,16 @@ long long StickyRefiner::SweepBehind(const std::atomic<int>* ahead, std::atomic<
       moved += Move(x, y);
     }
     done.store(y + 1, std::memory_order_release);
+    done.notify_one();  // the sweep behind, if it waits (cheap when nobody does)
   }
   return moved;
 }
 
 void StickyRefiner::WaitForRows(const std::atomic<int>& ahead, int rows) const {
-  while (ahead.load(std::memory_order_acquire) < rows) std::this_thread::yield();
+  for (int finished = ahead.load(std::memory_order_acquire); finished < rows;
+       finished = ahead.load(std::memory_order_acquire)) {
+    ahead.wait(finished, std::memory_order_acquire);
+  }
 }
 
 void StickyRefiner::WaitForLabels(const std::atomic<int>& ahead, int x, int y) const {
@@ -304,7 +307,9 @@ void StickyRefiner::WaitForLabels(const std::atomic<int>& ahead, int x, int y) c
   for (;;) {
     const int finished = ahead.load(std::memory_order_acquire);
     if (finished >= image_.height || LastRowAround(x, y) <= finished - 2) return;
-    std::this_thread::yield();
+    // Blocks (after a short spin) until the sweep ahead finishes another row: on a machine
+    // where the two sweeps share a core, spinning would take its time from the sweep ahead.
+    ahead.wait(finished, std::memory_order_acquire);
   }
 }
 
