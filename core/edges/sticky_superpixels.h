@@ -14,7 +14,7 @@ struct StickySuperpixelParams {
   float beta = 0.9f;   // edge vs colour
   int iterations = 4;  // full-resolution iterations (2x at half resolution)
   // Sweep order (RefineStickyLabels): 0 = raster order (the reference and the default; with the
-  // request's threads, two sweeps at once, one following the other, with the same labels);
+  // request's threads, several sweeps at once, each following the one before, same labels);
   // n > 0 = strips of n full-resolution rows, side by side on the request's threads.
   // Strips of 32 rows make the stage ~1.3x faster on two threads but cost pixel metrics on real
   // frames (README, Speed), so a bundle takes them only when trained so (--superpixel-strips).

@@ -183,7 +183,7 @@ class StickyRefiner {
     sums_[best].Add(1.0, x, y, c);
     if (!extents_.empty()) extents_[best].Add(y);
     if (last_row_) {
-      // One writer per label at a time (SweepPair), so a load and a store suffice.
+      // One writer per label at a time (SweepChain), so a load and a store suffice.
       std::atomic<int>& last = last_row_[best];
       if (last.load(std::memory_order_relaxed) < y) last.store(y, std::memory_order_relaxed);
     }
@@ -210,9 +210,10 @@ class StickyRefiner {
   // One sweep in raster order (the reference order); returns the pixels moved.
   long long SweepRaster() { return SweepRows(0, image_.height, nullptr, nullptr); }
 
-  // Two raster sweeps at once, the second a few rows behind the first, with exactly the moves of
-  // two sweeps one after the other (see RefineStickyLabels); returns the pixels each moved.
-  std::array<long long, 2> SweepPair();
+  // `count` raster sweeps at once, each a few rows behind the one before it, with exactly the
+  // moves of the sweeps one after the other (see RefineStickyLabels); returns the pixels each
+  // moved.
+  std::vector<long long> SweepChain(int count);
 
   // One sweep in strips of strip_rows rows, the first one `shift` rows short: the even strips side
   // by side, then the odd ones, each in raster order (see RefineStickyLabels). Needs the extents
@@ -234,14 +235,17 @@ class StickyRefiner {
   // whose rows, grown by one on each side, meet its extent.
   std::vector<char> SharedLabels(int strip_rows, int shift, int parity) const;
 
-  // A raster sweep that publishes the rows it has finished in `done`. With `ahead` (the rows the
-  // sweep before it has finished), it waits until that sweep can no longer touch what it reads.
-  long long SweepBehind(const std::atomic<int>* ahead, std::atomic<int>& done);
-  // Waits until the sweep ahead has finished `rows` rows.
-  void WaitForRows(const std::atomic<int>& ahead, int rows) const;
+  // Sweep `index` of a chain, in raster order; publishes the rows it has finished in
+  // done[index]. From index 1 on it waits until the sweeps ahead can no longer touch what it reads.
+  long long SweepInChain(std::vector<std::atomic<int>>& done, int index);
+  // The rows the sweep just ahead of sweep `index` has finished. The counters of the sweeps
+  // further ahead are read too, so that what they wrote before those rows is visible here.
+  static int RowsAhead(const std::vector<std::atomic<int>>& done, int index);
+  // Waits until the sweep just ahead has finished `rows` rows.
+  void WaitForRows(const std::vector<std::atomic<int>>& done, int index, int rows) const;
   // Waits until every label the move of (x, y) reads lies above the two rows next to the sweep
-  // ahead (or that sweep is done): that sweep can then no longer read or change those labels.
-  void WaitForLabels(const std::atomic<int>& ahead, int x, int y) const;
+  // just ahead (or that sweep is done): no sweep ahead can then read or change those labels.
+  void WaitForLabels(const std::vector<std::atomic<int>>& done, int index, int x, int y) const;
   // The largest last_row_ among the labels of (x, y) and its 4-neighbours.
   int LastRowAround(int x, int y) const;
 
@@ -250,66 +254,75 @@ class StickyRefiner {
   std::vector<int>& labels_;
   std::vector<LabelSums> sums_;
   std::vector<RowExtent> extents_;  // per label, kept by SweepStrips
-  // Per label during SweepPair: a bound on the last row its pixels lie in (moves only raise it).
+  // Per label during SweepChain: a bound on the last row its pixels lie in (moves only raise it).
   std::unique_ptr<std::atomic<int>[]> last_row_;
 };
 
-std::array<long long, 2> StickyRefiner::SweepPair() {
+std::vector<long long> StickyRefiner::SweepChain(int count) {
   last_row_ = std::make_unique<std::atomic<int>[]>(sums_.size());
   for (int y = 0; y < image_.height; ++y)
     for (int x = 0; x < image_.width; ++x)
       last_row_[labels_[static_cast<size_t>(y) * image_.width + x]].store(
           y, std::memory_order_relaxed);
-  std::array<std::atomic<int>, 2> done{};
-  std::array<long long, 2> moved{};
-  // A task takes its sweep when it starts, so the first sweep always belongs to a running task and
-  // never waits: the pair cannot deadlock, however the pool schedules (or serialises) the tasks.
+  std::vector<std::atomic<int>> done(static_cast<size_t>(count));
+  std::vector<long long> moved(static_cast<size_t>(count), 0);
+  // A task takes its sweep when it starts, so every sweep a sweep waits for belongs to a task
+  // that is running, and the first never waits: the chain cannot deadlock, however the pool
+  // schedules (or serialises) the tasks.
   std::atomic<int> next{0};
-  cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(0, count), [&](const cv::Range& range) {
     for (int n = range.start; n < range.end; ++n) {
       const int sweep = next.fetch_add(1);
-      moved[sweep] = SweepBehind(sweep == 0 ? nullptr : &done[0], done[sweep]);
+      moved[sweep] = SweepInChain(done, sweep);
     }
   });
   last_row_.reset();
   return moved;
 }
 
-long long StickyRefiner::SweepBehind(const std::atomic<int>* ahead, std::atomic<int>& done) {
+long long StickyRefiner::SweepInChain(std::vector<std::atomic<int>>& done, int index) {
   long long moved = 0;
   for (int y = 0; y < image_.height; ++y) {
     // OnBorder reads the row below: the sweep ahead must be past it.
-    if (ahead != nullptr) WaitForRows(*ahead, std::min(image_.height, y + 2));
+    if (index > 0) WaitForRows(done, index, std::min(image_.height, y + 2));
     for (int x = 0; x < image_.width; ++x) {
       if (!OnBorder(x, y)) continue;
-      if (ahead != nullptr) WaitForLabels(*ahead, x, y);
+      if (index > 0) WaitForLabels(done, index, x, y);
       moved += Move(x, y);
     }
-    done.store(y + 1, std::memory_order_release);
-    done.notify_one();  // the sweep behind, if it waits (cheap when nobody does)
+    done[index].store(y + 1, std::memory_order_release);
+    done[index].notify_one();  // the sweep behind, if it waits (cheap when nobody does)
   }
   return moved;
 }
 
-void StickyRefiner::WaitForRows(const std::atomic<int>& ahead, int rows) const {
-  for (int finished = ahead.load(std::memory_order_acquire); finished < rows;
-       finished = ahead.load(std::memory_order_acquire)) {
-    ahead.wait(finished, std::memory_order_acquire);
+int StickyRefiner::RowsAhead(const std::vector<std::atomic<int>>& done, int index) {
+  const int rows = done[index - 1].load(std::memory_order_acquire);
+  for (int k = index - 2; k >= 0; --k) (void)done[k].load(std::memory_order_acquire);
+  return rows;
+}
+
+void StickyRefiner::WaitForRows(const std::vector<std::atomic<int>>& done, int index,
+                                int rows) const {
+  for (int finished = RowsAhead(done, index); finished < rows; finished = RowsAhead(done, index)) {
+    done[index - 1].wait(finished, std::memory_order_acquire);
   }
 }
 
-void StickyRefiner::WaitForLabels(const std::atomic<int>& ahead, int x, int y) const {
-  // The sweep ahead has finished rows [0, done) and is at row `done`: its remaining moves read
-  // and write only labels with a pixel in row done - 1 or below. A label whose pixels all lie in
-  // rows <= done - 2 is not next to any pixel it has yet to visit, and a pixel only ever joins
-  // a neighbour's label, so it never reaches such a label again. The bounds it raised before
-  // finishing a row are visible once that row's `done` is (release / acquire).
+void StickyRefiner::WaitForLabels(const std::vector<std::atomic<int>>& done, int index, int x,
+                                  int y) const {
+  // The sweep just ahead has finished rows [0, d) and is at row d; every sweep further ahead is
+  // further down (each waits for the rows below the one it is at). Their remaining moves read and
+  // write only labels with a pixel in row d - 1 or below. A label whose pixels all lie in rows
+  // <= d - 2 is not next to any pixel they have yet to visit, and a pixel only ever joins a
+  // neighbour's label, so they never reach such a label again. The bounds a sweep raised before
+  // finishing a row are visible once that row's counter is (release / acquire).
   for (;;) {
-    const int finished = ahead.load(std::memory_order_acquire);
+    const int finished = RowsAhead(done, index);
     if (finished >= image_.height || LastRowAround(x, y) <= finished - 2) return;
     // Blocks (after a short spin) until the sweep ahead finishes another row: on a machine
-    // where the two sweeps share a core, spinning would take its time from the sweep ahead.
-    ahead.wait(finished, std::memory_order_acquire);
+    // where the sweeps share a core, spinning would take its time from the sweep ahead.
+    done[index - 1].wait(finished, std::memory_order_acquire);
   }
 }
 
@@ -398,17 +411,19 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
   // Strips only pay off when there are several of them.
   const bool in_strips = strip_rows > 0 && height > 2 * strip_rows;
   if (in_strips) refiner.ResetExtents();
-  // The raster order with two threads: sweeps in pairs, the second one rows behind the first.
-  const bool in_pairs = !in_strips && cv::getNumThreads() > 1;
+  // The raster order on several threads: as many sweeps at once, each rows behind the one before.
+  const int chain = in_strips ? 1 : std::max(1, cv::getNumThreads());
   int sweeps = 0;
   for (int iter = 0; iter < iterations;) {
-    if (in_pairs && iter + 1 < iterations) {
-      // A sweep that moves nothing leaves the state as it found it, so the sweep after it (here
-      // its partner) moves nothing either: the count is that of sweeps one after the other.
-      const std::array<long long, 2> moved = refiner.SweepPair();
-      sweeps += moved[0] == 0 ? 1 : 2;
-      if (moved[0] == 0 || moved[1] == 0) break;
-      iter += 2;
+    const int count = std::min(chain, iterations - iter);
+    if (count > 1) {
+      // A sweep that moves nothing leaves the state as it found it, so every sweep after it moves
+      // nothing either: the count is that of sweeps one after the other.
+      const std::vector<long long> moved = refiner.SweepChain(count);
+      const auto first_still = std::find(moved.begin(), moved.end(), 0LL) - moved.begin();
+      sweeps += static_cast<int>(std::min<std::ptrdiff_t>(first_still + 1, count));
+      if (first_still < count) break;
+      iter += count;
     } else {
       ++sweeps;
       // The first sweep runs in raster order: from one label per pixel, strips started afresh at

@@ -41,13 +41,13 @@ struct StickyImage {
 // sums see the moves below it before those above it): on real 1754 x 663 crops 98.7 % of the
 // boundary pixels are the same and 99.6 % lie within a pixel of one.
 //
-// In raster order with more than one thread (cv::getNumThreads), sweeps run in pairs: the second
-// starts while the first is still running and follows it down the rows, moving a pixel only once
-// the first sweep can no longer read or change any label that move reads (every such label lies
-// above the two rows next to the first sweep's current row; a bound on each label's last row is
-// kept as pixels join it). The moves are then exactly those of the two sweeps one after the
-// other, so the labels are bit-identical to one thread's (the reference): only the serial sweep's
-// time is shared between two cores.
+// In raster order with more than one thread (cv::getNumThreads), as many sweeps run at once as
+// there are threads: each starts while the one before it is still running and follows it down the
+// rows, moving a pixel only once no sweep ahead can read or change any label that move reads
+// (every such label lies above the two rows next to the current row of the sweep just ahead; a
+// bound on each label's last row is kept as pixels join it). The moves are then exactly those of
+// the sweeps one after the other, so the labels are bit-identical to one thread's (the
+// reference): only the serial sweeps' time is shared between cores.
 int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, int iterations,
                        std::vector<int>& labels, int strip_rows = 0);
 

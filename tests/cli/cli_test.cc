@@ -104,7 +104,7 @@ TEST_F(CliTest, DetectWritesJsonMapAndOverlay) {
     EXPECT_EQ(e.path().filename().string().find("_stage"), std::string::npos) << e.path();
 }
 
-// --threads-per-request splits a frame's work (the superpixel sweeps run in pairs, the scans,
+// --threads-per-request splits a frame's work (the superpixel sweeps run side by side, the scans,
 // features and regressors in pieces), never its result: one and two threads write the same
 // proposals, scores, obstacles and map.
 TEST_F(CliTest, DetectGivesTheSameResultOnOneAndTwoThreads) {

@@ -216,10 +216,10 @@ TEST(RefineStickyLabelsTest, StripsGiveTheSameLabelsOnAnyThreads) {
   EXPECT_GT(tallest, 6);
 }
 
-// The raster order on two or three threads runs its sweeps in pairs, the second a few rows behind
-// the first. The size term grows labels over many rows, so the second sweep must often wait for
-// the first to leave a label alone: the labels must still be those of one thread, bit for bit.
-TEST(RefineStickyLabelsTest, PairedSweepsGiveTheLabelsOfOneThread) {
+// The raster order on several threads runs as many sweeps at once, each a few rows behind the one
+// before it. The size term grows labels over many rows, so a sweep must often wait for the ones
+// ahead to leave a label alone: the labels must still be those of one thread, bit for bit.
+TEST(RefineStickyLabelsTest, ChainedSweepsGiveTheLabelsOfOneThread) {
   const int width = 240, height = 180;
   cv::Mat3f colour(height, width);
   cv::Mat1f edge(height, width);
@@ -234,7 +234,7 @@ TEST(RefineStickyLabelsTest, PairedSweepsGiveTheLabelsOfOneThread) {
     for (size_t i = 0; i < initial.size(); ++i) initial[i] = static_cast<int>(i);
     std::vector<std::vector<int>> results;
     std::vector<int> sweeps;
-    for (const int threads : {1, 2, 3}) {
+    for (const int threads : {1, 2, 3, 4}) {
       cv::setNumThreads(threads);
       ASSERT_EQ(cv::getNumThreads(), threads);
       for (const int iterations : {5, 8}) {
