@@ -23,6 +23,38 @@ Superpixels Computed(const cv::Mat3b& bgr, const cv::Mat1f& edge,
   return sp.ok() ? std::move(sp).value() : Superpixels{};
 }
 
+// Uniform random colours and edges in [0, 1], and one label per pixel to start the refinement
+// from: with a strong size term its labels grow freely, over many rows.
+struct NoiseScene {
+  cv::Mat3f colour;
+  cv::Mat1f edge;
+  std::vector<int> one_label_per_pixel;
+  StickyImage view() const {
+    return StickyImage{colour.cols, colour.rows, colour.ptr<float>(0), edge.ptr<float>(0)};
+  }
+};
+
+NoiseScene MakeNoise(int width, int height, int seed) {
+  NoiseScene s{cv::Mat3f(height, width), cv::Mat1f(height, width),
+               std::vector<int>(static_cast<size_t>(width) * height)};
+  cv::RNG rng(seed);
+  rng.fill(s.colour, cv::RNG::UNIFORM, 0.f, 1.f);
+  rng.fill(s.edge, cv::RNG::UNIFORM, 0.f, 1.f);
+  for (size_t i = 0; i < s.one_label_per_pixel.size(); ++i)
+    s.one_label_per_pixel[i] = static_cast<int>(i);
+  return s;
+}
+
+// Smooth random colour blobs: a cell grid of random colours resized with cubic interpolation.
+cv::Mat3b BlobImage(cv::Size size, cv::Size cells, int seed) {
+  cv::Mat3b blobs(cells);
+  cv::RNG rng(seed);
+  rng.fill(blobs, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat3b image;
+  cv::resize(blobs, image, size, 0, 0, cv::INTER_CUBIC);
+  return image;
+}
+
 // A dark disc on a flat light background; Ê = 1 on the disc's inner contour, 0 elsewhere.
 struct DiscScene {
   cv::Mat3b image;
@@ -183,15 +215,10 @@ TEST(RefineStickyLabelsTest, EdgeTermSnapsBorderToEdge) {
 // not depend on how many threads run the strips.
 TEST(RefineStickyLabelsTest, StripsGiveTheSameLabelsOnAnyThreads) {
   const int width = 64, height = 48;
-  cv::Mat3f colour(height, width);
-  cv::Mat1f edge(height, width);
-  cv::RNG rng(5);
-  rng.fill(colour, cv::RNG::UNIFORM, 0.f, 1.f);
-  rng.fill(edge, cv::RNG::UNIFORM, 0.f, 1.f);
-  const StickyImage image{width, height, colour.ptr<float>(0), edge.ptr<float>(0)};
+  const NoiseScene scene = MakeNoise(width, height, 5);
+  const StickyImage image = scene.view();
   const StickyWeights w{.size = 50.0, .position = 1e-4, .edge = 0.1, .colour = 0.05};
-  std::vector<int> initial(static_cast<size_t>(width) * height);
-  for (size_t i = 0; i < initial.size(); ++i) initial[i] = static_cast<int>(i);
+  const std::vector<int>& initial = scene.one_label_per_pixel;
   const int threads_before = cv::getNumThreads();
   std::vector<std::vector<int>> results;
   for (const int threads : {1, 3}) {
@@ -220,18 +247,12 @@ TEST(RefineStickyLabelsTest, StripsGiveTheSameLabelsOnAnyThreads) {
 // before it. The size term grows labels over many rows, so a sweep must often wait for the ones
 // ahead to leave a label alone: the labels must still be those of one thread, bit for bit.
 TEST(RefineStickyLabelsTest, ChainedSweepsGiveTheLabelsOfOneThread) {
-  const int width = 240, height = 180;
-  cv::Mat3f colour(height, width);
-  cv::Mat1f edge(height, width);
-  cv::RNG rng(11);
-  rng.fill(colour, cv::RNG::UNIFORM, 0.f, 1.f);
-  rng.fill(edge, cv::RNG::UNIFORM, 0.f, 1.f);
-  const StickyImage image{width, height, colour.ptr<float>(0), edge.ptr<float>(0)};
+  const NoiseScene scene = MakeNoise(240, 180, 11);
+  const StickyImage image = scene.view();
+  const std::vector<int>& initial = scene.one_label_per_pixel;
   const int threads_before = cv::getNumThreads();
   for (const double size : {0.5, 50.0}) {
     const StickyWeights w{.size = size, .position = 1e-4, .edge = 0.1, .colour = 0.05};
-    std::vector<int> initial(static_cast<size_t>(width) * height);
-    for (size_t i = 0; i < initial.size(); ++i) initial[i] = static_cast<int>(i);
     std::vector<std::vector<int>> results;
     std::vector<int> sweeps;
     for (const int threads : {1, 2, 3, 4}) {
@@ -253,11 +274,11 @@ TEST(RefineStickyLabelsTest, ChainedSweepsGiveTheLabelsOfOneThread) {
 
 // The whole stage on a textured scene: the superpixels of two threads are those of one.
 TEST(StickySuperpixelsTest, TwoThreadsGiveTheSuperpixelsOfOne) {
-  cv::Mat3b image(240, 320);
+  // The edges continue the blobs' random sequence (this scene makes the sweeps wait often).
   cv::RNG rng(4);
-  cv::Mat3b blobs(24, 32);
+  cv::Mat3b blobs(24, 32), image;
   rng.fill(blobs, cv::RNG::UNIFORM, 0, 256);
-  cv::resize(blobs, image, image.size(), 0, 0, cv::INTER_CUBIC);
+  cv::resize(blobs, image, cv::Size(320, 240), 0, 0, cv::INTER_CUBIC);
   cv::Mat1f edge(image.size());
   rng.fill(edge, cv::RNG::UNIFORM, 0.f, 1.f);
   const int threads_before = cv::getNumThreads();
@@ -275,11 +296,7 @@ TEST(StickySuperpixelsTest, TwoThreadsGiveTheSuperpixelsOfOne) {
 // boundary pixels are the same; on this textured scene at least 95 %, and 98 % within a pixel of
 // one.
 TEST(StickySuperpixelsTest, StripOrderStaysCloseToRasterOrder) {
-  cv::Mat3b image(300, 400);
-  cv::RNG rng(9);
-  cv::Mat3b blobs(30, 40);
-  rng.fill(blobs, cv::RNG::UNIFORM, 0, 256);
-  cv::resize(blobs, image, image.size(), 0, 0, cv::INTER_CUBIC);
+  const cv::Mat3b image = BlobImage({400, 300}, {40, 30}, 9);
   cv::Mat1b grey;
   cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   cv::Mat1f gx, gy, edge;
