@@ -11,6 +11,7 @@
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
 #include "core/cli/request_options.h"
+#include "core/data/image_file.h"
 #include "core/pipeline/detection_output.h"
 #include "core/pipeline/frame_budget.h"
 #include "core/pipeline/model_bundle.h"
@@ -70,12 +71,15 @@ Runner AddDetectCommand(CLI::App& app) {
     int failures = 0;
     for (const std::string& path : args->images) {
       const auto read_start = std::chrono::steady_clock::now();
-      const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
-      if (image.empty()) {
-        std::cerr << "tod: " << path << ": not a readable image\n";
+      // Decoded as tod_server and tod bench decode (plain PNGs without libpng).
+      const Result<cv::Mat> read = ReadImageFile(path, cv::IMREAD_COLOR, "image");
+      if (!read.ok()) {
+        std::cerr << "tod: " << path << ": not a readable image (" << read.status().message()
+                  << ")\n";
         ++failures;
         continue;
       }
+      const cv::Mat& image = *read;
       // The frame budget counts from decoding, as in tod_server and tod bench.
       DetectOptions options = args->options;
       if (options.budget_ms > 0) {

@@ -5,13 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 
 #include "core/base/memory_usage.h"
+#include "core/data/image_file.h"
 #include "core/pipeline/detection_output.h"
 #include "core/pipeline/edge_boxes_baseline.h"
 #include "core/pipeline/frame_budget.h"
@@ -36,14 +35,6 @@ bool IsFrameFile(const std::filesystem::path& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".webp";
-}
-
-Result<std::vector<uchar>> ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::NotFound("cannot open " + path);
-  std::vector<uchar> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) return Status::DataLoss("cannot read " + path);
-  return bytes;
 }
 
 // The detector's stage names mapped onto the contract's (only probability_map differs).
@@ -87,14 +78,13 @@ Status CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchReco
 // The timed part: decode, the detector's call exactly as `tod detect` makes it, and the map
 // encoded as `tod detect` writes it. The decoded frame is handed back for the counting pass; the
 // detection is released here, so its maps are not held while the counting pass runs.
-Result<FrameBenchRecord> TimeFrame(const ObstacleDetector& detector,
-                                   const std::vector<uchar>& bytes, const DetectOptions& options,
-                                   cv::Mat3b& bgr) {
+Result<FrameBenchRecord> TimeFrame(const ObstacleDetector& detector, const std::string& bytes,
+                                   const DetectOptions& options, cv::Mat3b& bgr) {
   const Clock::time_point start = Clock::now();
-  const cv::Mat decoded = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  Result<cv::Mat3b> decoded = DecodeColourImage(bytes);
   const Clock::time_point decoded_at = Clock::now();
-  if (decoded.empty()) return Status::InvalidArgument("not a decodable image");
-  bgr = decoded;
+  if (!decoded.ok()) return decoded.status();
+  bgr = std::move(decoded).value();
   // The frame budget counts from the start of decoding, as the server counts it.
   DetectOptions detect = options;
   detect.budget_ms = BudgetLeftMs(detect.budget_ms, MsBetween(start, decoded_at));
@@ -121,7 +111,7 @@ Result<FrameBenchRecord> TimeFrame(const ObstacleDetector& detector,
 Result<FrameBenchRecord> MeasureFrame(const ObstacleDetector& detector, const std::string& path,
                                       const DetectOptions& options) {
   // Reading the file is the storage's time, not ours: done before the clock starts.
-  const auto bytes = ReadBytes(path);
+  const Result<std::string> bytes = ReadFileBytes(path);
   if (!bytes.ok()) return bytes.status();
   cv::Mat3b bgr;
   auto record = TimeFrame(detector, *bytes, options, bgr);

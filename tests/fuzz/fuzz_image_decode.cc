@@ -5,8 +5,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <opencv2/imgcodecs.hpp>
 #include <string_view>
 
+#include "core/data/plain_png.h"
 #include "server/core/image_codec.h"
 #include "server/core/image_header.h"
 #include "server/core/strict_decoders.h"
@@ -34,6 +36,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Check(image->size() == header->size);
   } else {
     Check(!image.status().message().empty());
+  }
+
+  // The plain-PNG decoder agrees with libpng: whatever it accepts, libpng (lenient, through
+  // OpenCV) decodes to the same pixels. It may refuse more (it is strict); never less.
+  const tod::Result<cv::Mat3b> plain = tod::DecodePlainPng(bytes, kMaxPixels);
+  if (plain.ok()) {
+    Check(tod::IsPlainPng(bytes) && !plain->empty() &&
+          plain->total() <= static_cast<size_t>(kMaxPixels));
+    const cv::Mat reference = cv::imdecode(
+        cv::Mat(1, static_cast<int>(size), CV_8U, const_cast<uint8_t*>(data)), cv::IMREAD_COLOR);
+    Check(!reference.empty() && reference.size() == plain->size() &&
+          cv::norm(reference, *plain, cv::NORM_INF) == 0);
   }
 
   // The decoders are also called directly (DecodeImage only reaches the one the header names),
