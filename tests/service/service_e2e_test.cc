@@ -320,6 +320,38 @@ TEST_F(ServiceE2ETest, TheCalibratedMapIsBoundedByTheBestBoxsCalibratedScore) {
   EXPECT_NE(ErrorMessage(refused).find("map_kind"), std::string::npos) << refused->body;
 }
 
+// RGB and RGBA PNGs take the plain-PNG decoder, a palette PNG libpng; the same pixels give the
+// same detections whichever decoder ran, and a damaged chunk is the client's error.
+TEST_F(ServiceE2ETest, EveryPngLayoutGivesTheSameDetections) {
+  const cv::Mat3b road = testing::RoadFrame(320, 160);
+  cv::Mat rgba;
+  cv::cvtColor(road, rgba, cv::COLOR_BGR2BGRA);
+  const std::string rgb_png = testing::Encode(road, ".png");
+  const std::string rgba_png = testing::Encode(rgba, ".png");
+  const auto detect = [&](const std::string& png) {
+    const auto result = PostImage(*http_, "/v1/detect?map=none", png);
+    EXPECT_TRUE(result && result->status == 200) << (result ? result->body : "no answer");
+    return result ? nlohmann::json::parse(result->body)["proposals"] : nlohmann::json();
+  };
+  const nlohmann::json from_rgb = detect(rgb_png);
+  ASSERT_FALSE(from_rgb.empty());
+  EXPECT_EQ(detect(rgba_png), from_rgb);
+  // The same frame through libpng: grey levels only, so a grey PNG holds it exactly.
+  cv::Mat1b grey;
+  cv::cvtColor(road, grey, cv::COLOR_BGR2GRAY);
+  cv::Mat3b grey_bgr;
+  cv::cvtColor(grey, grey_bgr, cv::COLOR_GRAY2BGR);
+  EXPECT_EQ(detect(testing::Encode(grey, ".png")), detect(testing::Encode(grey_bgr, ".png")));
+
+  std::string damaged = rgb_png;
+  damaged[damaged.size() - 20] ^= 0x01;  // inside the last IDAT chunk's data
+  const auto refused = PostImage(*http_, "/v1/detect", damaged);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400);
+  EXPECT_NE(ErrorMessage(refused).find("CRC"), std::string::npos) << refused->body;
+  ExpectStillServes();
+}
+
 TEST_F(ServiceE2ETest, RestErrorsHaveCodesAndMessages) {
   struct Case {
     std::string path;
