@@ -131,6 +131,11 @@ Runner AddTrainCommand(CLI::App& app) {
                 "weight each box of the probability map by how isolated it is among the frame's "
                 "best boxes, to the power fitted on the calibration's out-of-fold maps (the "
                 "default; --no-map-isolation: the paper's map)");
+  cmd->add_flag("--map-shares,!--no-map-shares",
+                args->train.params.probability_map.superpixel_shares,
+                "the probability map adds each box's score to a pixel times the share of the "
+                "pixel's superpixel the box holds (the default; --no-map-shares: whole boxes, "
+                "the paper's map)");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,

@@ -143,8 +143,11 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
       bp_fusion[j] = {bp_reg.proposals.boxes[j].box, fused[j]};
       bp_ordr[j] = {bp_reg.proposals.boxes[j].box, bp_reg.ordr[j]};
     }
-    const cv::Mat1f map_fusion =
-        AccumulateProbabilityMap(bp_fusion, s.image.size(), bundle.params.probability_map);
+    const MapSuperpixels superpixels{oaocc.superpixels, oaocc.r1};
+    Result<cv::Mat1f> fusion_made = AccumulateProbabilityMap(
+        bp_fusion, s.image.size(), bundle.params.probability_map, &superpixels);
+    if (!fusion_made.ok()) return fusion_made.status();
+    const cv::Mat1f map_fusion = std::move(fusion_made).value();
     timer.Mark("probability_map");
 
     ProposalSet op = MergeRegionBoxes(plain_regions, bundle.params.region_merge_iou);
@@ -154,10 +157,14 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     std::vector<ScoredBox> op_ordr(op_reg.ordr.size());
     for (std::size_t j = 0; j < op_ordr.size(); ++j)
       op_ordr[j] = {op_reg.proposals.boxes[j].box, op_reg.ordr[j]};
-    const cv::Mat1f map_bp_ordr =
-        AccumulateProbabilityMap(bp_ordr, s.image.size(), bundle.params.probability_map);
-    const cv::Mat1f map_op_ordr =
-        AccumulateProbabilityMap(op_ordr, s.image.size(), bundle.params.probability_map);
+    Result<cv::Mat1f> bp_ordr_made = AccumulateProbabilityMap(
+        bp_ordr, s.image.size(), bundle.params.probability_map, &superpixels);
+    Result<cv::Mat1f> op_ordr_made = AccumulateProbabilityMap(
+        op_ordr, s.image.size(), bundle.params.probability_map, &superpixels);
+    if (!bp_ordr_made.ok()) return bp_ordr_made.status();
+    if (!op_ordr_made.ok()) return op_ordr_made.status();
+    const cv::Mat1f map_bp_ordr = std::move(bp_ordr_made).value();
+    const cv::Mat1f map_op_ordr = std::move(op_ordr_made).value();
     const float min_score = bundle.params.probability_map.min_score;
     cv::Mat1f map_calibrated;
     if (calibrated_map) {
@@ -167,9 +174,14 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
       map_calibrated = std::move(*made);
     }
 
-    // Reported obstacles at the detector's defaults (calibrated score >= 0.5).
+    // Reported obstacles at the detector's defaults (calibrated score >= 0.5), from the map the
+    // detector takes them from.
+    Result<cv::Mat1f> obstacle_made = ObstacleComponentsMap(
+        bp_fusion, s.image.size(), bundle.params, MapKind::kNormalized, map_fusion);
+    if (!obstacle_made.ok()) return obstacle_made.status();
+    const cv::Mat1f obstacle_map = std::move(obstacle_made).value();
     const std::vector<DetectedObstacle> reported =
-        ScoreObstacles(map_fusion, bp_fusion, bundle.params, DetectOptions{});
+        ScoreObstacles(obstacle_map, bp_fusion, bundle.params, DetectOptions{});
     int false_alarms = 0;
     for (const DetectedObstacle& o : reported)
       false_alarms += cv::countNonZero(s.obstacle(o.box.rect())) == 0;

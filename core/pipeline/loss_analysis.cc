@@ -76,6 +76,7 @@ struct FrameResult {
 // The fused scores of `proposals` compared with where the obstacles are (FrameWork's score
 // fields), and the paper's map under the three scorings of PixelApBreakdown.
 Status ScoreAgainstObstacles(const ModelBundle& bundle, const Sample& s,
+                             const MapSuperpixels& superpixels,
                              const std::vector<ScoredBox>& proposals,
                              const std::vector<float>& fused, FrameResult& out) {
   auto table = MaskIoUTable::Build(s.instances);
@@ -102,9 +103,12 @@ Status ScoreAgainstObstacles(const ModelBundle& bundle, const Sample& s,
     scored[1][j] = {proposals[j].box, covers[j] ? fused[j] : 0.f};
     scored[2][j] = {proposals[j].box, perfect[j]};
   }
-  for (int k = 0; k < kApScorings; ++k)
-    out.maps[k] =
-        AccumulateProbabilityMap(scored[k], s.image.size(), bundle.params.probability_map);
+  for (int k = 0; k < kApScorings; ++k) {
+    Result<cv::Mat1f> map = AccumulateProbabilityMap(scored[k], s.image.size(),
+                                                     bundle.params.probability_map, &superpixels);
+    if (!map.ok()) return map.status();
+    out.maps[k] = std::move(map).value();
+  }
   return Status::Ok();
 }
 
@@ -144,7 +148,9 @@ Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return fused[a] > fused[b]; });
   std::vector<Box> by_fused;
   for (int i : order) by_fused.push_back(reg.proposals.boxes[i].box);
-  if (Status st = ScoreAgainstObstacles(bundle, s, reg.proposals.boxes, fused, out); !st.ok())
+  if (Status st = ScoreAgainstObstacles(bundle, s, {oaocc.superpixels, oaocc.r1},
+                                        reg.proposals.boxes, fused, out);
+      !st.ok())
     return st;
 
   out.work.frame = s.name;

@@ -16,17 +16,22 @@ MapIsolationFit::MapIsolationFit(std::vector<float> exponents, const PipelinePar
       pixels_(exponents_.size()),
       components_(exponents_.size(), std::vector<std::vector<std::pair<double, int>>>(frames)) {}
 
-Status MapIsolationFit::AddFrame(int frame, const Sample& sample,
+Status MapIsolationFit::AddFrame(int frame, const Sample& sample, const MapSuperpixels& superpixels,
                                  const std::vector<ScoredBox>& fused) {
   DetectOptions every_component;
   every_component.min_obstacle_score = -1.f;
   for (std::size_t c = 0; c < exponents_.size(); ++c) {
     PipelineParams params = params_;
     params.probability_map.isolation.exponent = exponents_[c];
-    const cv::Mat1f map =
-        AccumulateProbabilityMap(fused, sample.image.size(), params.probability_map);
+    Result<cv::Mat1f> made =
+        AccumulateProbabilityMap(fused, sample.image.size(), params.probability_map, &superpixels);
+    if (!made.ok()) return made.status();
+    const cv::Mat1f& map = *made;
+    const Result<cv::Mat1f> components =
+        ObstacleComponentsMap(fused, sample.image.size(), params, MapKind::kNormalized, map);
+    if (!components.ok()) return components.status();
     std::vector<std::pair<double, int>> found;
-    for (const DetectedObstacle& o : ScoreObstacles(map, fused, params, every_component))
+    for (const DetectedObstacle& o : ScoreObstacles(*components, fused, params, every_component))
       found.emplace_back(o.evidence, cv::countNonZero(sample.obstacle(o.box.rect())) > 0 ? 1 : 0);
     std::lock_guard lock(mutex_);
     if (Status st = pixels_[c].Add(map, sample.obstacle, sample.road); !st.ok()) return st;

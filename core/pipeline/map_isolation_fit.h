@@ -2,8 +2,8 @@
 // candidate exponent's map is built from the same out-of-fold fused boxes, its pixels pooled as
 // `tod eval` pools BP+Fusion@4 (obstacle against free space), and the exponent whose map has the
 // highest pixel AP wins (ties: the smaller one, the nearer the paper's map). The obstacles each
-// candidate's map yields are kept too, so that the score calibration is fitted on the components
-// of the map the bundle will serve.
+// candidate yields (from ObstacleComponentsMap, as the detector takes them) are kept too, so
+// that the score calibration is fitted on the components the bundle will report.
 #pragma once
 
 #include <mutex>
@@ -15,6 +15,7 @@
 #include "core/base/types.h"
 #include "core/metrics/pixel_histogram_metrics.h"
 #include "core/pipeline/pipeline_params.h"
+#include "core/pipeline/probability_map.h"
 
 namespace tod {
 
@@ -29,7 +30,9 @@ class MapIsolationFit {
 
   // One training frame's fused boxes (every proposal, F = 0 where gated out). Thread-safe; each
   // frame index at most once.
-  Status AddFrame(int frame, const Sample& sample, const std::vector<ScoredBox>& fused);
+  // `superpixels`: the frame's, for a map that weighs boxes by superpixel shares.
+  Status AddFrame(int frame, const Sample& sample, const MapSuperpixels& superpixels,
+                  const std::vector<ScoredBox>& fused);
 
   // The index of the winning candidate (call after every frame was added).
   int Best() const;

@@ -29,7 +29,17 @@ Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes
   if (kind == MapKind::kCalibrated)
     return CalibratedProbabilityMap(fused_boxes, image_size, params.obstacle_calibration,
                                     oaocc.superpixels, oaocc.r1);
-  return AccumulateProbabilityMap(fused_boxes, image_size, params.probability_map);
+  const MapSuperpixels superpixels{oaocc.superpixels, oaocc.r1};
+  return AccumulateProbabilityMap(fused_boxes, image_size, params.probability_map, &superpixels);
+}
+
+Result<cv::Mat1f> ObstacleComponentsMap(const std::vector<ScoredBox>& fused_boxes,
+                                        cv::Size image_size, const PipelineParams& params,
+                                        MapKind kind, const cv::Mat1f& served) {
+  if (kind != MapKind::kNormalized || !params.probability_map.superpixel_shares) return served;
+  ProbabilityMapParams whole_boxes = params.probability_map;
+  whole_boxes.superpixel_shares = false;
+  return AccumulateProbabilityMap(fused_boxes, image_size, whole_boxes);
 }
 
 namespace {
@@ -65,6 +75,11 @@ ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
 
 Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
                                            const DetectOptions& options) const {
+  return Detect(bgr, options, nullptr);
+}
+
+Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOptions& options,
+                                           MapSuperpixels* superpixels) const {
   if (bgr.empty()) return Status::InvalidArgument("empty image");
   if (bgr.cols < 16 || bgr.rows < 16)
     return Status::InvalidArgument("image too small: " + std::to_string(bgr.cols) + "x" +
@@ -117,7 +132,10 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
   out.map_kind = options.map_kind;
   out.width = bgr.cols;
   out.height = bgr.rows;
-  out.obstacles = ScoreObstacles(*probability, scored, bundle_.params, options);
+  const Result<cv::Mat1f> components =
+      ObstacleComponentsMap(scored, bgr.size(), bundle_.params, options.map_kind, *probability);
+  if (!components.ok()) return components.status();
+  out.obstacles = ScoreObstacles(*components, scored, bundle_.params, options);
   timer.Mark("probability_map");
 
   std::vector<std::size_t> order(fused.size());
@@ -133,6 +151,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
         {regressed.proposals.boxes[i].box, fused[i], regressed.ordr[i], regressed.obdr[i]});
   }
   if (options.want_probability_map) out.probability = std::move(*probability);
+  if (superpixels != nullptr) *superpixels = {oaocc.superpixels, oaocc.r1};
   out.timings = timer.times();
   return out;
 }

@@ -25,10 +25,23 @@ Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes
                                        cv::Size image_size, const OcclusionEdges& oaocc,
                                        const PipelineParams& params, MapKind kind);
 
+// The map whose components are a frame's obstacles: `served` itself, except that for the
+// normalised map with superpixel shares it is the same boxes painted whole. Shares tighten a
+// map's pixels around each object, but they split the boxes' area into more and smaller
+// components, on which the obstacles' calibration fits lower scores (README "Real frames",
+// point 19): the obstacle list, and the calibration, stay those of the whole-box map.
+Result<cv::Mat1f> ObstacleComponentsMap(const std::vector<ScoredBox>& fused_boxes,
+                                        cv::Size image_size, const PipelineParams& params,
+                                        MapKind kind, const cv::Mat1f& served);
+
 class ObstacleDetector final : public Detector {
  public:
   ObstacleDetector(ModelBundle bundle, std::string name);
   Result<Detection> Detect(const cv::Mat3b& bgr, const DetectOptions& options) const override;
+  // Detect, also handing back the frame's superpixels, with which a caller rebuilds the map
+  // under other parameters (the trainer's isolation fit). `superpixels` may be null.
+  Result<Detection> Detect(const cv::Mat3b& bgr, const DetectOptions& options,
+                           MapSuperpixels* superpixels) const;
   const ModelInfo& info() const override { return info_; }
   const ModelBundle& bundle() const { return bundle_; }
 

@@ -25,7 +25,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FusionParams, beta1, keep_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BoxIsolationParams, exponent, context_boxes,
                                                 surround)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score, nms_iou, max_boxes,
-                                                top_fraction, isolation)
+                                                top_fraction, isolation, superpixel_shares)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PriorCorrection, edge_odds, occlusion_odds)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ForestScreening, trees, final_at_most)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ObstacleCalibration, fitted, slope, intercept,
@@ -85,6 +85,7 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
 PipelineParams TrainingDefaultParams() {
   PipelineParams params;
   params.occlusion_screening = {.trees = 25, .final_at_most = 0.05f};
+  params.probability_map.superpixel_shares = true;
   return params;
 }
 

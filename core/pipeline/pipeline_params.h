@@ -96,7 +96,7 @@ struct PipelineParams {
 // the proposals take as an edge. Both dev folds x four forest seeds: every proposal and pixel
 // metric within 0.01 of the whole walk (TPR@FPR 0.02 0.801 -> 0.816), for about 40 % of the
 // occlusion stage (README, "Real frames", point 16). The bound 0.1 cost AP 0.015 and was not
-// taken.
+// taken. And the map weighs its boxes by superpixel shares (ProbabilityMapParams; point 19).
 PipelineParams TrainingDefaultParams();
 
 nlohmann::json ToJson(const PipelineParams& params);

@@ -49,38 +49,68 @@ float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_b
   return evidence;
 }
 
-cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
-                                   const ProbabilityMapParams& params) {
-  std::vector<ScoredBox> kept = MapBoxes(boxes, params);
-  if (params.isolation.exponent != 0.f) {
-    const std::vector<float> weights = IsolationWeights(kept, boxes, params.isolation);
-    for (std::size_t i = 0; i < kept.size(); ++i) kept[i].score *= weights[i];
-  }
-  const std::size_t top = kept.size();
-  // 2-D difference image: +s at the box's top-left, -s past its right / bottom, prefix sums.
+namespace {
+
+// The accumulated scores and their largest value (before the map is divided by it).
+struct ScoreSum {
+  cv::Mat1f sum;
+  double peak = 0;
+};
+
+// The paper's accumulation: a 2-D difference image, +s at each box's top-left and -s past its
+// right / bottom, then prefix sums. The peak is taken from the double sums.
+ScoreSum AccumulateWholeBoxes(const std::vector<ScoredBox>& kept, cv::Size image_size) {
   cv::Mat1d diff = cv::Mat1d::zeros(image_size.height + 1, image_size.width + 1);
-  for (std::size_t i = 0; i < top; ++i) {
-    const Box b = ClipToImage(kept[i].box, image_size.width, image_size.height);
+  for (const ScoredBox& k : kept) {
+    const Box b = ClipToImage(k.box, image_size.width, image_size.height);
     if (b.empty()) continue;
-    const double s = kept[i].score;
+    const double s = k.score;
     diff(b.y, b.x) += s;
     diff(b.y, b.right()) -= s;
     diff(b.bottom(), b.x) -= s;
     diff(b.bottom(), b.right()) += s;
   }
-  cv::Mat1f prob(image_size, 0.f);
+  ScoreSum out{cv::Mat1f(image_size, 0.f)};
   std::vector<double> column(image_size.width + 1, 0.0);
-  double peak = 0;
   for (int y = 0; y < image_size.height; ++y) {
     double run = 0;
     for (int x = 0; x < image_size.width; ++x) {
       column[x] += diff(y, x);
       run += column[x];
-      prob(y, x) = static_cast<float>(run);
-      peak = std::max(peak, run);
+      out.sum(y, x) = static_cast<float>(run);
+      out.peak = std::max(out.peak, run);
     }
   }
-  if (peak > 0) prob *= 1.0 / peak;
+  return out;
+}
+
+ScoreSum AccumulateShares(const std::vector<ScoredBox>& kept, cv::Size image_size,
+                          const MapSuperpixels& superpixels) {
+  ScoreSum out{cv::Mat1f(image_size, 0.f)};
+  SuperpixelShare share(superpixels.superpixels, superpixels.crop);
+  for (const ScoredBox& k : kept) share.PaintAdd(k.box, k.score, &out.sum);
+  cv::minMaxLoc(out.sum, nullptr, &out.peak);
+  return out;
+}
+
+}  // namespace
+
+Result<cv::Mat1f> AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
+                                           const ProbabilityMapParams& params,
+                                           const MapSuperpixels* superpixels) {
+  if (params.superpixel_shares && superpixels == nullptr) {
+    return Status::InvalidArgument(
+        "probability map: superpixel shares were asked for without the frame's superpixels");
+  }
+  std::vector<ScoredBox> kept = MapBoxes(boxes, params);
+  if (params.isolation.exponent != 0.f) {
+    const std::vector<float> weights = IsolationWeights(kept, boxes, params.isolation);
+    for (std::size_t i = 0; i < kept.size(); ++i) kept[i].score *= weights[i];
+  }
+  ScoreSum accumulated = params.superpixel_shares ? AccumulateShares(kept, image_size, *superpixels)
+                                                  : AccumulateWholeBoxes(kept, image_size);
+  cv::Mat1f& prob = accumulated.sum;
+  if (accumulated.peak > 0) prob *= 1.0 / accumulated.peak;
   cv::max(prob, 0.f, prob);  // rounding in the prefix sums must not leave tiny negatives
   return prob;
 }

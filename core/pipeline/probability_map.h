@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/base/status.h"
 #include "core/base/types.h"
 #include "core/edges/sticky_superpixels.h"
 #include "core/pipeline/box_isolation.h"
@@ -32,6 +33,20 @@ struct ProbabilityMapParams {
   // Each accumulated box's score times its isolation weight (box_isolation.h); exponent 0, the
   // default and the paper's map, leaves the scores as they are. `tod train` fits the exponent.
   BoxIsolationParams isolation;
+  // Each accumulated box adds its score to a pixel times the share of the pixel's sticky
+  // superpixel that the box holds (superpixel_share.h), as the calibrated map weighs it, so the
+  // road in a box's corners, whose superpixels run on past the box, gains little. false, the
+  // default and the paper's map, paints whole boxes; `tod train` turns it on
+  // (TrainingDefaultParams; README "Real frames", point 19).
+  bool superpixel_shares = false;
+};
+
+// The frame's sticky superpixels, for maps that weigh boxes by superpixel shares: the labels of
+// the crop whose top-left corner is at (crop.x, crop.y), R1 (OcclusionEdges). Pixels outside the
+// crop have no superpixel and take a box's whole score.
+struct MapSuperpixels {
+  Superpixels superpixels;  // shares the labels' buffer with the frame's (cv::Mat)
+  Box crop;
 };
 
 // Score-sorted boxes with score > min_score (before NMS): the ranked list used for instance
@@ -49,9 +64,13 @@ float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_b
 
 // §7 steps 2-5: threshold, NMS, top fraction, accumulate per pixel (difference image + prefix
 // sums, so the cost is linear in boxes plus pixels), normalise by the maximum. With an isolation
-// exponent, each accumulated box adds its score times its isolation weight among `boxes`.
-cv::Mat1f AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
-                                   const ProbabilityMapParams& params = {});
+// exponent, each accumulated box adds its score times its isolation weight among `boxes`. With
+// params.superpixel_shares, each box adds its score times the superpixel share of each pixel
+// (two passes over the accumulated boxes' pixels), which needs the frame's `superpixels`:
+// InvalidArgument without them.
+Result<cv::Mat1f> AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
+                                           const ProbabilityMapParams& params = {},
+                                           const MapSuperpixels* superpixels = nullptr);
 
 // The calibrated map (not in the paper): each pixel p holds the largest, over every box b with
 // F > 0 (every box the ORDR gate passed) that covers p, of CalibratedScore(F(b)) · share(p, b),

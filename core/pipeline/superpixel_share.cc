@@ -6,7 +6,10 @@ namespace tod {
 namespace {
 
 // Paints max(map, value) over the part of `rect` outside `hole` (both in map coordinates).
-void PaintMaxOutside(const cv::Rect& rect, const cv::Rect& hole, float value, cv::Mat1f* map) {
+// map(p) = combine(map(p), value) for the pixels of `rect` outside `hole`.
+template <typename Combine>
+void PaintOutside(const cv::Rect& rect, const cv::Rect& hole, float value, cv::Mat1f* map,
+                  Combine combine) {
   for (int y = rect.y; y < rect.y + rect.height; ++y) {
     float* row = (*map)[y];
     const bool row_in_hole = y >= hole.y && y < hole.y + hole.height && hole.width > 0;
@@ -15,10 +18,13 @@ void PaintMaxOutside(const cv::Rect& rect, const cv::Rect& hole, float value, cv
         x = hole.x + hole.width - 1;  // skip the hole
         continue;
       }
-      row[x] = std::max(row[x], value);
+      row[x] = combine(row[x], value);
     }
   }
 }
+
+constexpr auto kKeepLarger = [](float a, float b) { return std::max(a, b); };
+constexpr auto kAdd = [](float a, float b) { return a + b; };
 
 }  // namespace
 
@@ -68,11 +74,12 @@ void SuperpixelShare::ClearWeights() {
   touched_labels_.clear();
 }
 
-void SuperpixelShare::PaintMax(const Box& box, float value, cv::Mat1f* map) {
+template <typename Combine>
+void SuperpixelShare::Paint(const Box& box, float value, cv::Mat1f* map, Combine combine) {
   const Box clipped = ClipToImage(box, map->cols, map->rows);
   if (clipped.empty()) return;
   const Box on_crop = Intersect(clipped, crop_);
-  PaintMaxOutside(clipped.rect(), on_crop.rect(), value, map);
+  PaintOutside(clipped.rect(), on_crop.rect(), value, map, combine);
   if (on_crop.empty()) return;
   const cv::Rect local(on_crop.x - crop_.x, on_crop.y - crop_.y, on_crop.w, on_crop.h);
   WeighSuperpixels(local, value);
@@ -83,10 +90,18 @@ void SuperpixelShare::PaintMax(const Box& box, float value, cv::Mat1f* map) {
     for (int lx = local.x; lx < local.x + local.width; ++lx) {
       const int label = label_row[lx];
       const float v = label > 0 && label < labels ? weighted_[label] : BoundaryValue(lx, ly);
-      row[lx] = std::max(row[lx], v);
+      row[lx] = combine(row[lx], v);
     }
   }
   ClearWeights();
+}
+
+void SuperpixelShare::PaintMax(const Box& box, float value, cv::Mat1f* map) {
+  Paint(box, value, map, kKeepLarger);
+}
+
+void SuperpixelShare::PaintAdd(const Box& box, float value, cv::Mat1f* map) {
+  Paint(box, value, map, kAdd);
 }
 
 }  // namespace tod

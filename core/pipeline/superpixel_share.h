@@ -1,5 +1,6 @@
 // The share of a pixel's superpixel that a box holds: how likely the pixel belongs to the object
-// the box frames. The calibrated map (probability_map.h) weights a box's calibrated score by it,
+// the box frames. The calibrated map (probability_map.h) weights a box's calibrated score by it
+// (and the paper's map its fused score, with ProbabilityMapParams::superpixel_shares),
 // so the road in a box's corners, whose superpixels run on beyond the box, stays low, while an
 // obstacle's superpixels, which the sticky superpixels close along its contour (§3.2), lie
 // inside its box and keep the box's score. Not in the paper, whose map paints whole boxes.
@@ -25,11 +26,16 @@ class SuperpixelShare {
   // superpixels: it lies on the contour of the object on one of its sides.
   // Cost: two passes over the box's pixels.
   void PaintMax(const Box& box, float value, cv::Mat1f* map);
+  // map(p) += value * share(p, box), the same shares (the paper's map with superpixel shares).
+  void PaintAdd(const Box& box, float value, cv::Mat1f* map);
 
  private:
   // The part of `box` on the crop, in crop coordinates: counts the pixels of each superpixel in
   // it and sets weighted_[label] = value * share for every superpixel it touches.
   void WeighSuperpixels(const cv::Rect& on_crop, float value);
+  // map(p) = combine(map(p), value * share(p, box)) over the box (PaintMax, PaintAdd).
+  template <typename Combine>
+  void Paint(const Box& box, float value, cv::Mat1f* map, Combine combine);
   float BoundaryValue(int cx, int cy) const;  // crop coordinates, label 0 there
   void ClearWeights();
 

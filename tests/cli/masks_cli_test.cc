@@ -362,6 +362,41 @@ TEST_F(MasksCliTest, MapIsolationIsFittedByDefaultPaperMapOnRequest) {
   EXPECT_GT(cv::norm(maps[0], maps[1], cv::NORM_L1), 0.0);
 }
 
+// The map weighs boxes by superpixel shares by default (probability_map.h); --no-map-shares
+// paints whole boxes, as the paper. `tod detect` serves the map the bundle's parameters name, and
+// `tod eval` measures it.
+TEST_F(MasksCliTest, MapSharesAreOnByDefaultWholeBoxesOnRequest) {
+  const std::string shares = (out_ / "shares").string(), whole = (out_ / "whole").string();
+  const CommandResult shares_run = RunCommand(Train(shares, "--no-map-isolation"));
+  ASSERT_EQ(shares_run.exit_code, 0) << shares_run.output;
+  const CommandResult whole_run = RunCommand(Train(whole, "--no-map-isolation --no-map-shares"));
+  ASSERT_EQ(whole_run.exit_code, 0) << whole_run.output;
+  EXPECT_EQ(Manifest(shares)["params"]["probability_map"]["superpixel_shares"], true);
+  EXPECT_EQ(Manifest(whole)["params"]["probability_map"]["superpixel_shares"], false);
+  // The map does not change what is learned: the same forests either way.
+  EXPECT_EQ(Manifest(shares)["files"]["ordr.bin"]["fnv1a64"],
+            Manifest(whole)["files"]["ordr.bin"]["fnv1a64"]);
+  const std::string image = Root() + "/images/2.png";  // a frame of the set, with obstacles
+  cv::Mat maps[2];
+  nlohmann::json obstacles[2];
+  for (int k = 0; k < 2; ++k) {
+    const fs::path out = out_ / (k == 0 ? "detect_shares" : "detect_whole");
+    const CommandResult detect =
+        RunCommand(tod_ + " detect --min-obstacle-score 0 --model " + (k == 0 ? shares : whole) +
+                   " --out " + out.string() + " " + image);
+    ASSERT_EQ(detect.exit_code, 0) << detect.output;
+    maps[k] = cv::imread((out / "2_prob.png").string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(maps[k].empty());
+    std::ifstream json(out / "2.json");
+    obstacles[k] = nlohmann::json::parse(json)["obstacles"];
+  }
+  EXPECT_GT(cv::norm(maps[0], maps[1], cv::NORM_L1), 0.0);
+  // The obstacle list stays the whole-box map's (ObstacleComponentsMap), with the same
+  // calibration: the same obstacles and scores from either bundle.
+  EXPECT_FALSE(obstacles[0].empty());
+  EXPECT_EQ(obstacles[0], obstacles[1]);
+}
+
 // Two datasets trained together: the folds cut each into runs of its own (training_folds.h), and
 // the manifest names both.
 TEST_F(MasksCliTest, AddDataTrainsOnBothDatasetsWithFoldsInEach) {

@@ -63,12 +63,12 @@ TEST(IsolationWeights, TheMapPeaksOnTheIsolatedBox) {
   for (int i = 0; i < 9; ++i) boxes.push_back({Box{310 + 20 * i, 300, 20, 20}, 0.9f});
   ProbabilityMapParams paper;
   paper.top_fraction = 1.f;
-  const cv::Mat1f plain = AccumulateProbabilityMap(boxes, {640, 480}, paper);
+  const cv::Mat1f plain = AccumulateProbabilityMap(boxes, {640, 480}, paper).value();
   EXPECT_LT(plain(110, 110), 0.5f);
   EXPECT_FLOAT_EQ(plain(310, 335), 1.f);
   ProbabilityMapParams isolated = paper;
   isolated.isolation.exponent = 4.f;
-  const cv::Mat1f weighted = AccumulateProbabilityMap(boxes, {640, 480}, isolated);
+  const cv::Mat1f weighted = AccumulateProbabilityMap(boxes, {640, 480}, isolated).value();
   EXPECT_FLOAT_EQ(weighted(110, 110), 1.f);
   // Over the pixel: the box at x 320 (3 centres inside, 6 in its surround: the stripe starts at
   // 310) and the one at x 330 (3 of 7), against the lone box's 0.5.

@@ -42,7 +42,7 @@ TEST(ProbabilityMap, MatchesBruteForceAccumulationAndPeaksOnTheObstacle) {
       {{10, 10, 10, 10}, 0.9f}, {{11, 10, 10, 10}, 0.8f},  // IoU 0.82 with the first: removed
       {{40, 5, 8, 8}, 0.7f},    {{5, 30, 12, 6}, 0.6f},
       {{30, 30, 5, 5}, 0.5f},   {{0, 0, 64, 48}, 0.2f}};  // below 0.25: dropped
-  const cv::Mat1f map = AccumulateProbabilityMap(boxes, {64, 48});
+  const cv::Mat1f map = AccumulateProbabilityMap(boxes, {64, 48}).value();
   // Kept after NMS: 0.9, 0.7, 0.6, 0.5 -> top half = the 0.9 and 0.7 boxes.
   const cv::Mat1f expected = BruteForceMap({boxes[0], boxes[2]}, {64, 48});
   EXPECT_LT(cv::norm(map, expected, cv::NORM_INF), 1e-5);
@@ -51,8 +51,42 @@ TEST(ProbabilityMap, MatchesBruteForceAccumulationAndPeaksOnTheObstacle) {
   EXPECT_FLOAT_EQ(map(33, 10), 0.f);
 }
 
+// With superpixel shares, a box adds its score to a pixel times the share of the pixel's
+// superpixel it holds: an obstacle's superpixel inside the box keeps the box's score, the road's
+// superpixel running on past it gets its share, and pixels off the crop the whole score.
+TEST(ProbabilityMap, SuperpixelSharesWeighEachBoxsPixels) {
+  const cv::Size size(40, 30);
+  MapSuperpixels superpixels;
+  superpixels.crop = {0, 10, 40, 20};  // rows 10..29 have superpixels, rows 0..9 none
+  superpixels.superpixels.count = 2;
+  superpixels.superpixels.labels = cv::Mat1i(20, 40, 1);           // road: label 1
+  superpixels.superpixels.labels(cv::Rect(10, 5, 5, 5)).setTo(2);  // an obstacle: label 2
+  // One box around the obstacle (frame rows 14..20), one in the rows without superpixels.
+  const std::vector<ScoredBox> boxes = {{{8, 14, 9, 7}, 0.9f}, {{30, 2, 5, 5}, 0.8f}};
+  ProbabilityMapParams params;
+  params.top_fraction = 1.f;
+  params.superpixel_shares = true;
+  const Result<cv::Mat1f> map = AccumulateProbabilityMap(boxes, size, params, &superpixels);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  // Road pixels in the box: the box holds 63 - 25 = 38 of the road's 800 - 25 pixels.
+  const float road = 0.9f * 38.f / 775.f;
+  EXPECT_FLOAT_EQ((*map)(17, 12), 1.f);  // the obstacle: the frame's peak
+  EXPECT_NEAR((*map)(14, 8), road / 0.9f, 1e-6);
+  EXPECT_NEAR((*map)(3, 31), 0.8f / 0.9f, 1e-6);  // off the crop: the whole score
+  EXPECT_EQ((*map)(25, 25), 0.f);
+  // Without shares, the same boxes are painted whole.
+  params.superpixel_shares = false;
+  const cv::Mat1f whole = AccumulateProbabilityMap(boxes, size, params).value();
+  EXPECT_FLOAT_EQ(whole(14, 8), 1.f);
+  // Shares without the frame's superpixels are the caller's error, not whole boxes.
+  params.superpixel_shares = true;
+  const Result<cv::Mat1f> refused = AccumulateProbabilityMap(boxes, size, params);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
+}
+
 TEST(ProbabilityMap, NoBoxesGiveAnAllZeroMap) {
-  const cv::Mat1f map = AccumulateProbabilityMap({}, {16, 8});
+  const cv::Mat1f map = AccumulateProbabilityMap({}, {16, 8}).value();
   EXPECT_EQ(cv::countNonZero(map), 0);
 }
 

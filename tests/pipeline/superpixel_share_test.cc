@@ -37,9 +37,12 @@ Superpixels RandomSuperpixels(int width, int height, int seeds, std::mt19937& rn
   return sp;
 }
 
+// How a painted value meets the map's: kept if larger (PaintMax) or added (PaintAdd).
+enum class Combine { kMax, kAdd };
+
 // The definition, pixel by pixel.
-void ReferencePaintMax(const Superpixels& sp, const Box& crop, const Box& box, float value,
-                       cv::Mat1f* map) {
+void ReferencePaint(const Superpixels& sp, const Box& crop, const Box& box, float value,
+                    Combine combine, cv::Mat1f* map) {
   const Box b = ClipToImage(box, map->cols, map->rows);
   auto label_at = [&](int x, int y) {  // frame coordinates; -1 outside the crop
     const int cx = x - crop.x, cy = y - crop.y;
@@ -71,11 +74,12 @@ void ReferencePaintMax(const Superpixels& sp, const Box& crop, const Box& box, f
           if (n > 0) v = std::max(v, weight_of(n));
         }
       }
-      (*map)(y, x) = std::max((*map)(y, x), v);
+      (*map)(y, x) = combine == Combine::kMax ? std::max((*map)(y, x), v) : (*map)(y, x) + v;
     }
 }
 
-TEST(SuperpixelShareTest, EqualsThePixelByPixelDefinition) {
+// Random boxes, some partly or wholly off the crop and the frame, painted one after the other.
+void ExpectTheDefinition(Combine combine) {
   std::mt19937 rng(7);
   const cv::Size frame(90, 60);
   const Box crop{12, 9, 60, 40};
@@ -87,13 +91,21 @@ TEST(SuperpixelShareTest, EqualsThePixelByPixelDefinition) {
   for (int i = 0; i < 200; ++i) {
     const Box box{x(rng), y(rng), side(rng), side(rng)};
     const float v = value(rng);
-    share.PaintMax(box, v, &fast);
-    ReferencePaintMax(sp, crop, box, v, &reference);
+    if (combine == Combine::kMax) {
+      share.PaintMax(box, v, &fast);
+    } else {
+      share.PaintAdd(box, v, &fast);
+    }
+    ReferencePaint(sp, crop, box, v, combine, &reference);
     // A touched superpixel neighbouring a boundary pixel outside this box must not leak its
     // weight into the next box: compare after every box.
     ASSERT_EQ(cv::countNonZero(fast != reference), 0) << "box " << i;
   }
 }
+
+TEST(SuperpixelShareTest, EqualsThePixelByPixelDefinition) { ExpectTheDefinition(Combine::kMax); }
+
+TEST(SuperpixelShareTest, AddsThePixelByPixelDefinition) { ExpectTheDefinition(Combine::kAdd); }
 
 }  // namespace
 }  // namespace tod
