@@ -246,6 +246,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   report.instances = recall.at("EB").instances();
   report.reported = alarms;
   report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;
+  report.map_superpixel_shares = bundle.params.probability_map.superpixel_shares;
   report.free_space = road_labelled && not_obstacle
                           ? "mixed: the road label where the frame has one, else every non-void "
                             "non-obstacle pixel"
@@ -291,6 +292,7 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
                     {"instances_found", per(a.instances_found, r.instances)}};
   j["free_space"] = r.free_space;
   j["map_isolation_exponent"] = r.map_isolation_exponent;
+  j["map_superpixel_shares"] = r.map_superpixel_shares;
   auto ar = [](const VariantCurves& c) {
     nlohmann::json a = nlohmann::json::object();
     for (const auto& [n, v] : c.ar_table) a[std::to_string(n)] = v;
@@ -329,7 +331,9 @@ std::string FormatEvalTables(const EvalReport& r) {
   o << "paper's map: "
     << (r.map_isolation_exponent > 0.f
             ? "each box weighted by its isolation^" + Fixed(r.map_isolation_exponent, 1)
-            : std::string("as published (no isolation weight)"))
+            : std::string("no isolation weight"))
+    << (r.map_superpixel_shares ? ", each pixel by its superpixel's share of the box"
+                                : ", whole boxes")
     << "\n";
   {
     const ReportedObstacleCounts& a = r.reported;

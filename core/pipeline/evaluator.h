@@ -72,6 +72,7 @@ struct EvalReport {
   // The bundle's isolation exponent of the paper's map (box_isolation.h): the regression
   // variants' maps weigh each box by isolation^this; 0 is the paper's map as published.
   float map_isolation_exponent = 0.f;
+  bool map_superpixel_shares = false;  // the paper's map weighs boxes by superpixel shares
   int instances = 0;
   std::map<std::string, VariantCurves> proposals;   // proposal variants
   std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)

@@ -224,6 +224,7 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
   const nlohmann::json manifest = nlohmann::json::parse(manifest_in);
   EXPECT_DOUBLE_EQ(j["map_isolation_exponent"].get<double>(),
                    manifest["params"]["probability_map"]["isolation"]["exponent"].get<double>());
+  EXPECT_EQ(j["map_superpixel_shares"], manifest["params"]["probability_map"]["superpixel_shares"]);
   EXPECT_NE(run.output.find("paper's map: "), std::string::npos) << run.output;
 }
 
