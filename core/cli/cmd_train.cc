@@ -54,10 +54,21 @@ Runner AddTrainCommand(CLI::App& app) {
                   "frames for the edge and occlusion classifiers");
   cmd->add_option("--trees", args->trees, "trees per regressor (paper: 200)")
       ->check(CLI::Range(1, 2000));
+  cmd->add_option("--regressor-mtry", args->train.regressor.max_features,
+                  "features tried per split of ORDR and OBDR (Liaw-Wiener default: 6 of 20)")
+      ->check(CLI::Range(1, 64));
+  cmd->add_option("--regressor-min-leaf", args->train.regressor.min_leaf_size,
+                  "samples a leaf of ORDR and OBDR holds at least (Liaw-Wiener default: 5)")
+      ->check(CLI::Range(1, 100000));
   cmd->add_option("--negatives-scale", args->negatives_scale,
                   "regressor negatives per frame and vertical range, as a multiple of the "
                   "paper's (ORDR 17, OBDR 25)")
       ->check(CLI::Range(0.1, 20.0));
+  cmd->add_option("--negative-bags", args->train.selection.negative_bags,
+                  "regressors: draw the negatives N times (disjoint draws of the paper's counts) "
+                  "and fit each regressor as N forests of trees/N, each on every positive and "
+                  "one draw (balanced bagging; 1 = the paper's single draw)")
+      ->check(CLI::Range(1, kMaxNegativeBags));
   cmd->add_option("--edge-trees", args->train.edge_params.forest.num_trees,
                   "trees of the pixel edge classifier")
       ->check(CLI::Range(1, 200));

@@ -86,6 +86,11 @@ Status ValidateSelectionInput(const Sample& gt, const std::vector<int>& range_li
   if (!(params.hard_fraction >= 0.0 && params.hard_fraction <= 1.0)) {
     return Status::InvalidArgument(where + "params.hard_fraction must lie in [0, 1]");
   }
+  if (params.negative_bags < 1 || params.negative_bags > kMaxNegativeBags) {
+    return Status::InvalidArgument(where + "params.negative_bags must lie in [1, " +
+                                   std::to_string(kMaxNegativeBags) + "], got " +
+                                   std::to_string(params.negative_bags));
+  }
   if (gt.road.empty()) {
     return Status::InvalidArgument(where + "the road mask is empty; categories need it");
   }
@@ -173,12 +178,14 @@ Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& prop
 
   std::mt19937_64 rng(seed);
   const int num_ranges = static_cast<int>(range_limits.size()) - 1;
+  // Each bag draws from what the earlier bags left, so the bags are disjoint.
+  std::vector<char> drawn_before(num_proposals, 0);
   const auto select_negatives = [&](ProposalCategory wanted, const std::vector<int>& counts) {
     std::vector<int> negatives;
     for (int k = 0; k < num_ranges; ++k) {
       std::vector<int> hard, easy;
       for (int i = 0; i < num_proposals; ++i) {
-        if (range[i] != k || category[i] != wanted || is_positive[i] ||
+        if (range[i] != k || category[i] != wanted || is_positive[i] || drawn_before[i] ||
             max_iou[i] >= params.obstacle_iou) {
           continue;
         }
@@ -187,6 +194,20 @@ Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& prop
       const std::vector<int> drawn =
           DrawNegatives(hard, easy, counts[k], params.hard_fraction, rng);
       negatives.insert(negatives.end(), drawn.begin(), drawn.end());
+    }
+    for (int i : negatives) drawn_before[i] = 1;
+    return negatives;
+  };
+  // The negatives of every bag, in bag order, with the bag of each.
+  const auto select_bags = [&](ProposalCategory wanted, const std::vector<int>& counts,
+                               std::vector<int>& bags) {
+    std::fill(drawn_before.begin(), drawn_before.end(), 0);
+    std::vector<int> negatives;
+    bags.assign(out.positive_indices.size(), SelectedSamples::kEveryBag);
+    for (int bag = 0; bag < params.negative_bags; ++bag) {
+      const std::vector<int> drawn = select_negatives(wanted, counts);
+      negatives.insert(negatives.end(), drawn.begin(), drawn.end());
+      bags.insert(bags.end(), drawn.size(), bag);
     }
     return negatives;
   };
@@ -207,16 +228,17 @@ Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& prop
     // every non-obstacle proposal is category (i) and OBDR draws its negatives, independently of
     // ORDR's, from the same pool. The two regressors then differ by their samples only, and the
     // fusion acts as a two-member ensemble instead of adding a background expert.
-    assemble(select_negatives(ProposalCategory::kRoad, params.ordr_negatives), out.ordr_indices,
-             out.ordr_targets);
-    assemble(select_negatives(ProposalCategory::kRoad, params.obdr_negatives), out.obdr_indices,
-             out.obdr_targets);
+    // (The two draws are independent: a proposal may be a negative of both.)
+    assemble(select_bags(ProposalCategory::kRoad, params.ordr_negatives, out.ordr_bags),
+             out.ordr_indices, out.ordr_targets);
+    assemble(select_bags(ProposalCategory::kRoad, params.obdr_negatives, out.obdr_bags),
+             out.obdr_indices, out.obdr_targets);
     return out;
   }
-  assemble(select_negatives(ProposalCategory::kRoad, params.ordr_negatives), out.ordr_indices,
-           out.ordr_targets);
-  assemble(select_negatives(ProposalCategory::kBackground, params.obdr_negatives), out.obdr_indices,
-           out.obdr_targets);
+  assemble(select_bags(ProposalCategory::kRoad, params.ordr_negatives, out.ordr_bags),
+           out.ordr_indices, out.ordr_targets);
+  assemble(select_bags(ProposalCategory::kBackground, params.obdr_negatives, out.obdr_bags),
+           out.obdr_indices, out.obdr_targets);
   return out;
 }
 

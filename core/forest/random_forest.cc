@@ -146,6 +146,37 @@ Result<RandomForest> RandomForest::Fit(const cv::Mat1f& features, const std::vec
   return forest;
 }
 
+Result<RandomForest> RandomForest::Join(const std::vector<RandomForest>& parts) {
+  RandomForest joined;
+  long long total_nodes = 0;
+  for (const RandomForest& part : parts) {
+    if (part.empty()) continue;
+    if (joined.num_features_ != 0 && part.num_features_ != joined.num_features_) {
+      return Status::InvalidArgument("RandomForest::Join: a part has " +
+                                     std::to_string(part.num_features_) + " features, another " +
+                                     std::to_string(joined.num_features_));
+    }
+    joined.num_features_ = part.num_features_;
+    total_nodes += part.num_nodes();
+  }
+  if (total_nodes > kMaxNodes) {
+    return Status::ResourceExhausted("RandomForest::Join: the forest would have " +
+                                     std::to_string(total_nodes) + " nodes, more than " +
+                                     std::to_string(kMaxNodes));
+  }
+  joined.nodes_.reserve(static_cast<std::size_t>(total_nodes));
+  for (const RandomForest& part : parts) {
+    const auto offset = static_cast<std::int32_t>(joined.nodes_.size());
+    for (const std::int32_t root : part.tree_roots_) joined.tree_roots_.push_back(root + offset);
+    for (Node node : part.nodes_) {
+      if (node.feature >= 0) node.left += offset;
+      joined.nodes_.push_back(node);
+    }
+  }
+  joined.PackForPrediction();
+  return joined;
+}
+
 float RandomForest::Predict(const float* row) const {
   if (tree_roots_.empty()) return 0.f;
   double sum = 0.0;

@@ -66,6 +66,11 @@ class RandomForest {
   static Result<RandomForest> Fit(const cv::Mat1f& features, const std::vector<float>& targets,
                                   const ForestParams& params);
 
+  // One forest holding the trees of `parts` in order (e.g. forests fitted on different bags of
+  // samples). Its prediction is the mean over all their trees, which for parts with equally
+  // many trees is the mean of the parts' predictions. The parts must agree on num_features().
+  static Result<RandomForest> Join(const std::vector<RandomForest>& parts);
+
   // row must hold num_features() values. An empty forest predicts 0.
   float Predict(const float* row) const;
   // One prediction per row; empty when features.cols != num_features() (for a non-empty forest).

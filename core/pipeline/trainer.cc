@@ -485,6 +485,9 @@ ProposalSet Subset(const ProposalSet& all, const std::vector<int>& indices) {
 struct RegressorSamples {
   std::vector<cv::Mat1f> ordr_rows, obdr_rows;
   std::vector<std::vector<float>> ordr_targets, obdr_targets;
+  // Per row: SelectedSamples::kEveryBag or the negative bag that drew it.
+  std::vector<std::vector<int>> ordr_bags, obdr_bags;
+  int num_bags = 1;
   long long proposals = 0;
 };
 
@@ -500,6 +503,8 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
   RegressorSamples out;
   out.ordr_rows.resize(n), out.obdr_rows.resize(n);
   out.ordr_targets.resize(n), out.obdr_targets.resize(n);
+  out.ordr_bags.resize(n), out.obdr_bags.resize(n);
+  out.num_bags = options.selection.negative_bags;
   std::vector<long long> proposals(n, 0);
   const std::vector<int> limits = bundle.regions.RangeLimits();
   std::atomic<int> done{0};
@@ -538,6 +543,8 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
                                                      Subset(all, selected->obdr_indices), features);
           out.ordr_targets[i] = selected->ordr_targets;
           out.obdr_targets[i] = selected->obdr_targets;
+          out.ordr_bags[i] = selected->ordr_bags;
+          out.obdr_bags[i] = selected->obdr_bags;
         }
         const int finished = ++done;
         if (finished % 10 == 0 || finished == static_cast<int>(survey.usable.size()))
@@ -555,38 +562,58 @@ struct Regressors {
   RandomForest ordr, obdr;
   int ordr_samples = 0, obdr_samples = 0;
 };
+// One regressor on the samples of the frames `in_fold(i)` accepts: with one bag the paper's
+// forest; with several (SampleSelectionParams::negative_bags) one forest per bag, on every
+// positive and that bag's negatives, with its share of the trees, joined into one forest.
+Result<RandomForest> FitBaggedRegressor(const std::vector<cv::Mat1f>& parts,
+                                        const std::vector<std::vector<float>>& targets,
+                                        const std::vector<std::vector<int>>& bags, int num_bags,
+                                        const std::function<bool(int)>& in_fold,
+                                        const ForestParams& forest, int& samples) {
+  constexpr int kMinSamples = 10;
+  std::vector<RandomForest> forests;
+  samples = 0;
+  for (int bag = 0; bag < num_bags; ++bag) {
+    cv::Mat1f x;
+    std::vector<float> y;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      if (parts[i].empty() || !in_fold(static_cast<int>(i))) continue;
+      for (int r = 0; r < parts[i].rows; ++r) {
+        const int of = bags[i].empty() ? SelectedSamples::kEveryBag : bags[i][r];
+        if (of != SelectedSamples::kEveryBag && of != bag) continue;
+        x.push_back(parts[i].row(r));
+        y.push_back(targets[i][r]);
+        if (of == bag || bag == 0) ++samples;
+      }
+    }
+    if (x.rows < kMinSamples)
+      return Status::InvalidArgument(
+          "too few training samples (" + std::to_string(x.rows) + " in bag " + std::to_string(bag) +
+          ", need " + std::to_string(kMinSamples) + "); need frames with obstacles and free space");
+    ForestParams params = forest;
+    params.num_trees = forest.num_trees / num_bags + (bag < forest.num_trees % num_bags ? 1 : 0);
+    params.seed = forest.seed + 7919ULL * static_cast<std::uint64_t>(bag);
+    auto fitted = RandomForest::Fit(x, y, params);
+    if (!fitted.ok()) return fitted.status();
+    forests.push_back(std::move(*fitted));
+  }
+  if (num_bags == 1) return std::move(forests.front());
+  return RandomForest::Join(forests);
+}
+
 Result<Regressors> TrainRegressorPair(const RegressorSamples& samples,
                                       const std::function<bool(int)>& in_fold,
                                       ForestParams forest) {
-  const auto stack = [&](const std::vector<cv::Mat1f>& parts,
-                         const std::vector<std::vector<float>>& targets, cv::Mat1f& rows,
-                         std::vector<float>& y) {
-    for (std::size_t i = 0; i < parts.size(); ++i) {
-      if (parts[i].empty() || !in_fold(static_cast<int>(i))) continue;
-      rows.push_back(parts[i]);
-      y.insert(y.end(), targets[i].begin(), targets[i].end());
-    }
-  };
-  cv::Mat1f ordr_x, obdr_x;
-  std::vector<float> ordr_y, obdr_y;
-  stack(samples.ordr_rows, samples.ordr_targets, ordr_x, ordr_y);
-  stack(samples.obdr_rows, samples.obdr_targets, obdr_x, obdr_y);
-  constexpr int kMinSamples = 10;
-  if (ordr_x.rows < kMinSamples || obdr_x.rows < kMinSamples)
-    return Status::InvalidArgument(
-        "too few training samples for the regressors (" + std::to_string(ordr_x.rows) + " ORDR, " +
-        std::to_string(obdr_x.rows) + " OBDR, need " + std::to_string(kMinSamples) +
-        "); need frames with obstacles and free space");
   Regressors out;
-  auto ordr = RandomForest::Fit(ordr_x, ordr_y, forest);
+  auto ordr = FitBaggedRegressor(samples.ordr_rows, samples.ordr_targets, samples.ordr_bags,
+                                 samples.num_bags, in_fold, forest, out.ordr_samples);
   if (!ordr.ok()) return ordr.status().WithContext("ORDR");
   forest.seed += 1;
-  auto obdr = RandomForest::Fit(obdr_x, obdr_y, forest);
+  auto obdr = FitBaggedRegressor(samples.obdr_rows, samples.obdr_targets, samples.obdr_bags,
+                                 samples.num_bags, in_fold, forest, out.obdr_samples);
   if (!obdr.ok()) return obdr.status().WithContext("OBDR");
   out.ordr = std::move(*ordr);
   out.obdr = std::move(*obdr);
-  out.ordr_samples = ordr_x.rows;
-  out.obdr_samples = obdr_x.rows;
   return out;
 }
 
@@ -780,6 +807,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
         {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"},
         {"negatives_per_range", std::string(name) == "ordr" ? options.selection.ordr_negatives
                                                             : options.selection.obdr_negatives},
+        {"negative_bags", options.selection.negative_bags},
         {"maps", folds.enabled ? "out_of_fold" : "in_sample"},
         {"fold_layout", FoldLayoutName(options.fold_layout)}};
 

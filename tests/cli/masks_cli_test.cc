@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "core/pipeline/model_bundle.h"
 #include "tests/run_command.h"
 #include "tests/test_env.h"
 
@@ -184,9 +185,21 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
       Train(model,
             "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2 --superpixel-strips 16 "
             "--edge-negatives 3 --occlusion-negatives 6 --occlusion-screen-trees 3 "
-            "--occlusion-screen-below 0.25"));
+            "--occlusion-screen-below 0.25 --negative-bags 2 --regressor-mtry 4 "
+            "--regressor-min-leaf 7"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json manifest = Manifest(model);
+  for (const char* regressor : {"ordr", "obdr"}) {
+    const nlohmann::json& part = manifest["training"]["parts"][regressor];
+    EXPECT_EQ(part["negative_bags"], 2) << regressor;
+    EXPECT_EQ(part["mtry"], 4) << regressor;
+    EXPECT_EQ(part["min_leaf"], 7) << regressor;
+    EXPECT_EQ(part["trees"], 10) << regressor;  // two bags of 5 trees, joined
+  }
+  const auto bundle = tod::LoadModelBundle(model);
+  ASSERT_TRUE(bundle.ok()) << bundle.status().message();
+  EXPECT_EQ(bundle->ordr.num_trees(), 10);
+  EXPECT_EQ(bundle->obdr.num_trees(), 10);
   EXPECT_EQ(manifest["params"]["superpixels"]["strip_rows"], 16);
   EXPECT_EQ(manifest["params"]["occlusion_screening"]["trees"], 3);
   EXPECT_FLOAT_EQ(manifest["params"]["occlusion_screening"]["final_at_most"].get<float>(), 0.25f);
@@ -201,7 +214,8 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
             nlohmann::json({50, 50, 50, 50}));
   for (const char* flag :
        {"--edge-trees 0", "--negatives-scale 0", "--superpixel-strips -1", "--edge-negatives 0",
-        "--occlusion-negatives 0", "--occlusion-screen-trees -1", "--occlusion-screen-below 1"}) {
+        "--occlusion-negatives 0", "--occlusion-screen-trees -1", "--occlusion-screen-below 1",
+        "--negative-bags 0", "--regressor-mtry 0", "--regressor-min-leaf 0"}) {
     const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), flag));
     EXPECT_NE(wrong.exit_code, 0) << flag;
     EXPECT_NE(wrong.output.find(std::string(flag).substr(0, std::string(flag).find(' '))),

@@ -265,3 +265,46 @@ TEST(RandomForest, SampleFractionControlsBootstrapSize) {
 
 }  // namespace
 }  // namespace tod
+
+namespace tod {
+namespace {
+
+// Joined forests (one per bag of samples) predict the mean of the parts' predictions, keep every
+// tree, survive a save and load, and refuse parts that disagree on the features.
+TEST(RandomForest, JoinedForestsPredictTheMeanOfTheParts) {
+  auto f = [](const float* x) { return x[0] - x[2]; };
+  const Data a = MakeData(600, 3, 11, f);
+  const Data b = MakeData(600, 3, 12, f);
+  ForestParams params = SmallParams();
+  params.num_trees = 10;
+  const RandomForest first = FittedForest(a.x, a.y, params);
+  params.seed = 2;
+  const RandomForest second = FittedForest(b.x, b.y, params);
+  auto joined = RandomForest::Join({first, second});
+  ASSERT_TRUE(joined.ok()) << joined.status().message();
+  EXPECT_EQ(joined->num_trees(), 20);
+  EXPECT_EQ(joined->num_nodes(), first.num_nodes() + second.num_nodes());
+  const Data test = MakeData(200, 3, 13, f);
+  const std::vector<float> batch = joined->PredictBatch(test.x);
+  ASSERT_EQ(batch.size(), 200u);
+  for (int r = 0; r < test.x.rows; ++r) {
+    const float mean = 0.5f * (first.Predict(test.x[r]) + second.Predict(test.x[r]));
+    EXPECT_NEAR(joined->Predict(test.x[r]), mean, 1e-5f) << "row " << r;
+    EXPECT_EQ(batch[r], joined->Predict(test.x[r]));
+  }
+
+  const Result<std::string> bytes = EncodeModel(*joined);
+  ASSERT_TRUE(bytes.ok());
+  auto loaded = DecodeModel<RandomForest>(*bytes, "joined.bin");
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  EXPECT_EQ(loaded->PredictBatch(test.x), batch);
+
+  const Data wide = MakeData(100, 4, 14, f);
+  const RandomForest other = FittedForest(wide.x, wide.y, params);
+  auto mismatch = RandomForest::Join({first, other});
+  ASSERT_FALSE(mismatch.ok());
+  EXPECT_NE(mismatch.status().message().find("features"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace tod
