@@ -147,6 +147,11 @@ Runner AddTrainCommand(CLI::App& app) {
                 "the probability map adds each box's score to a pixel times the share of the "
                 "pixel's superpixel the box holds (the default; --no-map-shares: whole boxes, "
                 "the paper's map)");
+  cmd->add_flag("--vertical-edge-feature,!--no-vertical-edge-feature",
+                args->train.params.vertical_edge_feature,
+                "give the regressors a 21st proposal feature, the share of the box's strong "
+                "gradient on near-vertical edges (the default; --no-vertical-edge-feature: the "
+                "paper's 20 features)");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,

@@ -63,6 +63,26 @@ Status ValidateShared(const ColourIntegrals* frame_colour, const cv::Mat1f& regi
   return Status::Ok();
 }
 
+Status ValidateVertical(const VerticalEdgeIntegrals* frame_vertical,
+                        const BoxFeatureOptions& options, const cv::Mat1f& region_map,
+                        cv::Point region_origin) {
+  if (!options.vertical_edges) return Status::Ok();
+  if (frame_vertical == nullptr) {
+    return Status::InvalidArgument(
+        "BoxFeatureExtractor: options.vertical_edges needs the frame's vertical-edge tables "
+        "(frame_vertical is null)");
+  }
+  const cv::Rect crop(frame_vertical->origin(), frame_vertical->size());
+  const cv::Rect region(region_origin, region_map.size());
+  if ((region & crop) != region) {
+    return Status::InvalidArgument("BoxFeatureExtractor: region_map " +
+                                   PlaceText(region_map.size(), region_origin) +
+                                   " does not lie inside the frame_vertical crop " +
+                                   PlaceText(frame_vertical->size(), frame_vertical->origin()));
+  }
+  return Status::Ok();
+}
+
 // Sort key of a box for ComputeAll: tiles of 64 x 64 pixels (by the box centre) in row-major
 // order, then the centre's y and x.
 std::int64_t SpatialKey(const Box& b) {
@@ -99,20 +119,29 @@ BoxFeatureExtractor::BoxFeatureExtractor(const cv::Mat1f& region_map, const cv::
   if (!status_.ok()) return;
   colour_ = std::make_shared<const ColourIntegrals>(region_bgr, region_origin);
   region_in_colour_ = cv::Rect(cv::Point(0, 0), region_map.size());
+  if (options_.vertical_edges)
+    vertical_ = std::make_shared<const VerticalEdgeIntegrals>(region_bgr, region_origin);
 }
 
-BoxFeatureExtractor::BoxFeatureExtractor(std::shared_ptr<const ColourIntegrals> frame_colour,
-                                         const cv::Mat1f& region_map, cv::Point region_origin,
-                                         cv::Size image_size, const BoxFeatureOptions& options)
+BoxFeatureExtractor::BoxFeatureExtractor(
+    std::shared_ptr<const ColourIntegrals> frame_colour, const cv::Mat1f& region_map,
+    cv::Point region_origin, cv::Size image_size, const BoxFeatureOptions& options,
+    std::shared_ptr<const VerticalEdgeIntegrals> frame_vertical)
     : status_(ValidateShared(frame_colour.get(), region_map, region_origin, image_size)),
       options_(options),
       origin_(region_origin),
       image_size_(image_size) {
+  if (status_.ok())
+    status_ = ValidateVertical(frame_vertical.get(), options, region_map, region_origin);
   if (!status_.ok()) return;
   Init(region_map);
   if (!status_.ok()) return;
   region_in_colour_ = cv::Rect(region_origin - frame_colour->origin(), region_map.size());
   colour_ = std::move(frame_colour);
+  if (options_.vertical_edges) {
+    region_in_vertical_ = region_origin - frame_vertical->origin();
+    vertical_ = std::move(frame_vertical);
+  }
 }
 
 void BoxFeatureExtractor::Init(const cv::Mat1f& region_map) {
@@ -137,9 +166,10 @@ Result<BoxFeatureExtractor> BoxFeatureExtractor::Create(const cv::Mat1f& region_
 
 Result<BoxFeatureExtractor> BoxFeatureExtractor::Create(
     std::shared_ptr<const ColourIntegrals> frame_colour, const cv::Mat1f& region_map,
-    cv::Point region_origin, cv::Size image_size, const BoxFeatureOptions& options) {
+    cv::Point region_origin, cv::Size image_size, const BoxFeatureOptions& options,
+    std::shared_ptr<const VerticalEdgeIntegrals> frame_vertical) {
   BoxFeatureExtractor extractor(std::move(frame_colour), region_map, region_origin, image_size,
-                                options);
+                                options, std::move(frame_vertical));
   if (!extractor.status().ok()) return extractor.status();
   return extractor;
 }
@@ -196,6 +226,8 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
   const cv::Point to_colour = region_in_colour_.tl();
   cv::Rect box_in_colour(r.tl() + to_colour, r.size());
   const ColourMoments moments = colour_->Moments(box_in_colour);
+  if (vertical_)
+    f[20] = static_cast<float>(vertical_->Share({r.tl() + region_in_vertical_, r.size()}));
   for (int c = 0; c < 3; ++c) {
     const double mean = moments[c] / area;
     const double variance = moments[3 + c] / area - mean * mean;
@@ -227,7 +259,7 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
 }
 
 cv::Mat1f BoxFeatureExtractor::ComputeAll(const std::vector<ScoredBox>& proposals) const {
-  cv::Mat1f features(static_cast<int>(proposals.size()), kNumBoxFeatures);
+  cv::Mat1f features(static_cast<int>(proposals.size()), NumBoxFeatures(options_));
   std::vector<int> rows(proposals.size());
   for (std::size_t i = 0; i < rows.size(); ++i) rows[i] = static_cast<int>(i);
   ComputeInto(proposals, rows, features);
@@ -246,9 +278,11 @@ void BoxFeatureExtractor::ComputeInto(const std::vector<ScoredBox>& proposals,
     order[i] = {SpatialKey(b), static_cast<int>(i)};
   }
   std::sort(order.begin(), order.end());
+  const int columns = NumBoxFeatures(options_);
+  CV_Assert(out.cols == columns);
   for (const auto& [key, i] : order) {
     const BoxFeatureVector f = Compute(proposals[i].box, proposals[i].score);
-    std::copy(f.begin(), f.end(), out[out_rows[i]]);
+    std::copy(f.begin(), f.begin() + columns, out[out_rows[i]]);
   }
 }
 

@@ -3,7 +3,9 @@
 //  0 max edge, 1 mode edge, 2 mode proportion, 3 inner mean edge, 4 inner edge density,
 //  5 mean edge, 6 edge density, 7 normalised area, 8 aspect ratio, 9 objectness,
 //  10 X centre, 11 Y centre, 12 width, 13 height (full-image coordinates / actual image size),
-//  14-16 H/S/V standard deviation, 17-19 H/S/V contrast against the surround ring.
+//  14-16 H/S/V standard deviation, 17-19 H/S/V contrast against the surround ring;
+//  with BoxFeatureOptions::vertical_edges one more (ours): 20 the vertical edge share
+//  (vertical_edges.h).
 //
 // Cost model (1800 x 620 region): construction is one pass over the edge map (runs of one value
 // per row, sparse_edge_map.h: 12 B per run) plus, unless a frame-wide ColourIntegrals is shared,
@@ -34,11 +36,15 @@
 #include "core/features/colour_integrals.h"
 #include "core/features/hsv.h"  // BgrToHsv, HueBin, SatValBin, kHueBins, kSatValBins, ...
 #include "core/features/sparse_edge_map.h"
+#include "core/features/vertical_edges.h"
 
 namespace tod {
 
+// The paper's 20 features; a row has one more with BoxFeatureOptions::vertical_edges.
 inline constexpr int kNumBoxFeatures = 20;
-using BoxFeatureVector = std::array<float, kNumBoxFeatures>;
+inline constexpr int kMaxBoxFeatures = kNumBoxFeatures + 1;
+// Compute()'s result: the row's NumBoxFeatures(options) entries, the rest 0.
+using BoxFeatureVector = std::array<float, kMaxBoxFeatures>;
 
 struct BoxFeatureOptions {
   // ALGORITHM.md §5 "coordinates quirk": the original code computed features 10-11 from
@@ -55,14 +61,22 @@ struct BoxFeatureOptions {
   // *horizon_y in full-image pixels, at least 1. Unset: the centre column, w and h over the
   // image's width and height (the paper's).
   std::optional<double> horizon_y = std::nullopt;
+  // Feature 21 (index 20), the share of the box's strong gradient on near-vertical edges
+  // (vertical_edges.h). Off: the paper's 20 features.
+  bool vertical_edges = false;
 };
+
+// Columns of a feature row under `options`: 20, or 21 with vertical_edges.
+inline int NumBoxFeatures(const BoxFeatureOptions& options) {
+  return options.vertical_edges ? kMaxBoxFeatures : kNumBoxFeatures;
+}
 
 class BoxFeatureExtractor {
  public:
   // region_map: occlusion edge map of the region crop; region_bgr: colour crop of the same size;
   // region_origin: crop's top-left in the full image; image_size: full frame size.
-  // Builds the colour tables of this crop itself; prefer the shared form below when several
-  // regions of one frame are measured.
+  // Builds the colour tables (and, with options.vertical_edges, the vertical-edge tables) of this
+  // crop itself; prefer the shared form below when several regions of one frame are measured.
   // On invalid input (sizes differ, crop outside the frame, non-finite map values) the extractor
   // is empty, status() says why, and Compute() returns zeros except the objectness.
   BoxFeatureExtractor(const cv::Mat1f& region_map, const cv::Mat3b& region_bgr,
@@ -74,30 +88,35 @@ class BoxFeatureExtractor {
   // locates that crop in the full image; the region [region_origin, + region_map.size()) must lie
   // inside it. The surround ring of features 17-19 is still clipped to this region. Gives the
   // same features as the constructor above on the same region (up to double rounding in 14-16).
+  // With options.vertical_edges, frame_vertical holds the vertical-edge tables of the same larger
+  // crop (required; feature 21 then differs from the per-region form only in the region's border
+  // pixels, where the per-region tables reflect the crop instead of reading the frame).
   BoxFeatureExtractor(std::shared_ptr<const ColourIntegrals> frame_colour,
                       const cv::Mat1f& region_map, cv::Point region_origin, cv::Size image_size,
-                      const BoxFeatureOptions& options = {});
+                      const BoxFeatureOptions& options = {},
+                      std::shared_ptr<const VerticalEdgeIntegrals> frame_vertical = nullptr);
 
   // Same as the constructors, but invalid input is an error instead of an empty extractor.
   static Result<BoxFeatureExtractor> Create(const cv::Mat1f& region_map,
                                             const cv::Mat3b& region_bgr, cv::Point region_origin,
                                             cv::Size image_size,
                                             const BoxFeatureOptions& options = {});
-  static Result<BoxFeatureExtractor> Create(std::shared_ptr<const ColourIntegrals> frame_colour,
-                                            const cv::Mat1f& region_map, cv::Point region_origin,
-                                            cv::Size image_size,
-                                            const BoxFeatureOptions& options = {});
+  static Result<BoxFeatureExtractor> Create(
+      std::shared_ptr<const ColourIntegrals> frame_colour, const cv::Mat1f& region_map,
+      cv::Point region_origin, cv::Size image_size, const BoxFeatureOptions& options = {},
+      std::shared_ptr<const VerticalEdgeIntegrals> frame_vertical = nullptr);
 
   const Status& status() const { return status_; }
 
   // box: full-image coordinates; clipped to the region first. objectness: the OLP score.
   BoxFeatureVector Compute(const Box& box, float objectness) const;
 
-  // One row of 20 features per proposal (box + OLP score), in input order; thread-safe.
+  // One row of NumBoxFeatures(options) features per proposal (box + OLP score), in input order;
+  // thread-safe.
   cv::Mat1f ComputeAll(const std::vector<ScoredBox>& proposals) const;
-  // As ComputeAll, but the features of proposals[j] go to row out_rows[j] of `out` (20 columns,
-  // every out_rows[j] a row of it): a caller that merges several regions' proposals into one
-  // matrix writes each row once instead of copying it over.
+  // As ComputeAll, but the features of proposals[j] go to row out_rows[j] of `out`
+  // (NumBoxFeatures(options) columns, every out_rows[j] a row of it): a caller that merges several
+  // regions' proposals into one matrix writes each row once instead of copying it over.
   void ComputeInto(const std::vector<ScoredBox>& proposals, const std::vector<int>& out_rows,
                    cv::Mat1f& out) const;
 
@@ -113,6 +132,8 @@ class BoxFeatureExtractor {
   SparseEdgeMap edges_;
   std::shared_ptr<const ColourIntegrals> colour_;
   cv::Rect region_in_colour_;  // the region in colour_'s crop coordinates
+  std::shared_ptr<const VerticalEdgeIntegrals> vertical_;  // null unless options_.vertical_edges
+  cv::Point region_in_vertical_;  // the region's corner in vertical_'s crop
 };
 
 }  // namespace tod

@@ -234,10 +234,15 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
     return Status::InvalidArgument(manifest_path + ": unknown edge_source '" + bundle.edge_kind +
                                    "'");
   }
-  if (bundle.ordr.num_features() != kNumBoxFeatures ||
-      bundle.obdr.num_features() != kNumBoxFeatures)
+  // The manifest's feature set decides the row width; a forest of the other width was trained on
+  // other features, and reading its rows shifted would be silently wrong.
+  const int features = bundle.params.vertical_edge_feature ? kMaxBoxFeatures : kNumBoxFeatures;
+  if (bundle.ordr.num_features() != features || bundle.obdr.num_features() != features)
     return Status::DataLoss((root / kOrdrFile).string() + ": regressors must take " +
-                            std::to_string(kNumBoxFeatures) + " features");
+                            std::to_string(features) + " features (params.vertical_edge_feature " +
+                            (bundle.params.vertical_edge_feature ? "true" : "false") + "), not " +
+                            std::to_string(bundle.ordr.num_features()) + " / " +
+                            std::to_string(bundle.obdr.num_features()));
   return bundle;
 }
 

@@ -36,7 +36,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradien
                                                 superpixels, boxes, multistride, size_filter,
                                                 region_merge_iou, prior_correction, edge_screening,
                                                 occlusion_screening, obstacle_calibration, fusion,
-                                                probability_map, box_features, occlusion_features)
+                                                probability_map, box_features, occlusion_features,
+                                                vertical_edge_feature)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
 
@@ -86,6 +87,7 @@ PipelineParams TrainingDefaultParams() {
   PipelineParams params;
   params.occlusion_screening = {.trees = 25, .final_at_most = 0.05f};
   params.probability_map.superpixel_shares = true;
+  params.vertical_edge_feature = true;
   return params;
 }
 

@@ -86,6 +86,11 @@ struct PipelineParams {
   ProbabilityMapParams probability_map;
   GroundPlaneFeatureParams box_features;
   GroundPlaneFeatureParams occlusion_features;
+  // Proposal feature 21, the share of a box's strong gradient on near-vertical edges (ours;
+  // vertical_edges.h, README "Real frames", point 20). false, the default and the paper's 20
+  // features, so a bundle whose manifest predates it keeps its regressors' rows; `tod train`
+  // turns it on (TrainingDefaultParams).
+  bool vertical_edge_feature = false;
 };
 
 // The parameters `tod train` gives a new bundle: the defaults above, with the occlusion
@@ -96,7 +101,8 @@ struct PipelineParams {
 // the proposals take as an edge. Both dev folds x four forest seeds: every proposal and pixel
 // metric within 0.01 of the whole walk (TPR@FPR 0.02 0.801 -> 0.816), for about 40 % of the
 // occlusion stage (README, "Real frames", point 16). The bound 0.1 cost AP 0.015 and was not
-// taken. And the map weighs its boxes by superpixel shares (ProbabilityMapParams; point 19).
+// taken. And the map weighs its boxes by superpixel shares (ProbabilityMapParams; point 19), and
+// the proposals have the vertical edge share as a 21st feature (point 20).
 PipelineParams TrainingDefaultParams();
 
 nlohmann::json ToJson(const PipelineParams& params);

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "core/features/colour_integrals.h"
+#include "core/features/vertical_edges.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/parallel.h"
 
@@ -17,15 +18,19 @@ ProposalFeatureComputer::ProposalFeatureComputer(const cv::Mat3b& image,
   if (proposals.boxes.empty()) return;
   std::vector<bool> used(regions.num_layers(), false);
   for (const int k : proposals.layer) used[k] = true;
-  const auto frame_colour = std::make_shared<const ColourIntegrals>(
-      image(oaocc.r1.rect()), cv::Point(oaocc.r1.x, oaocc.r1.y));
+  const cv::Mat3b r1_bgr = image(oaocc.r1.rect());
+  const cv::Point r1_origin(oaocc.r1.x, oaocc.r1.y);
+  const auto frame_colour = std::make_shared<const ColourIntegrals>(r1_bgr, r1_origin);
+  const auto frame_vertical = options.vertical_edges
+                                  ? std::make_shared<const VerticalEdgeIntegrals>(r1_bgr, r1_origin)
+                                  : nullptr;
   // Each region's edge tables are one pass over its map, independent of the others.
   for (const Status& s : ParallelFor(regions.num_layers(), threads, [&](int k) {
          if (!used[k]) return Status::Ok();
          const Box region = Intersect(regions.layers[k], oaocc.r1);
          per_region_[k] = std::make_unique<const BoxFeatureExtractor>(
              frame_colour, RegionEdgeMap(oaocc, regions, k), cv::Point(region.x, region.y),
-             image.size(), options);
+             image.size(), options, frame_vertical);
          return Status::Ok();
        }))
     if (!s.ok()) throw std::runtime_error(s.ToString());
@@ -50,7 +55,7 @@ void ProposalFeatureComputer::ComputeRange(std::size_t begin, std::size_t end,
 cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
                                   const MultilayerRegions& regions, const ProposalSet& proposals,
                                   const BoxFeatureOptions& options) {
-  cv::Mat1f rows(static_cast<int>(proposals.boxes.size()), kNumBoxFeatures, 0.f);
+  cv::Mat1f rows(static_cast<int>(proposals.boxes.size()), NumBoxFeatures(options), 0.f);
   ProposalFeatureComputer(image, oaocc, regions, proposals, options)
       .ComputeRange(0, proposals.boxes.size(), rows);
   return rows;

@@ -1,4 +1,5 @@
-// The 20 features of a frame's proposals (§5), each computed on the region that produced it.
+// The 20 features of a frame's proposals (§5), and with BoxFeatureOptions::vertical_edges the
+// 21st, each computed on the region that produced it.
 #pragma once
 
 #include <cstddef>
@@ -27,7 +28,7 @@ class ProposalFeatureComputer {
   ProposalFeatureComputer(const cv::Mat3b& image, const OcclusionEdges& oaocc,
                           const MultilayerRegions& regions, const ProposalSet& proposals,
                           const BoxFeatureOptions& options, int threads = 1);
-  // Rows [begin, end) of `out` (proposals x kNumBoxFeatures) for proposals [begin, end).
+  // Rows [begin, end) of `out` (proposals x NumBoxFeatures(options)) for proposals [begin, end).
   void ComputeRange(std::size_t begin, std::size_t end, cv::Mat1f& out) const;
 
  private:
@@ -35,7 +36,7 @@ class ProposalFeatureComputer {
   std::vector<std::unique_ptr<const BoxFeatureExtractor>> per_region_;  // null: no proposal
 };
 
-// One row of 20 features per proposal.
+// One row of NumBoxFeatures(options) features per proposal.
 cv::Mat1f ComputeProposalFeatures(const cv::Mat3b& image, const OcclusionEdges& oaocc,
                                   const MultilayerRegions& regions, const ProposalSet& proposals,
                                   const BoxFeatureOptions& options);

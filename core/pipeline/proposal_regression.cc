@@ -42,10 +42,10 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   using Clock = std::chrono::steady_clock;
   RegressedProposals out;
   const std::size_t n = proposals.boxes.size();
-  cv::Mat1f features(static_cast<int>(n), kNumBoxFeatures, 0.f);
+  const BoxFeatureOptions feature_options = FeatureOptionsForFrame(bundle, image.cols, image.rows);
+  cv::Mat1f features(static_cast<int>(n), NumBoxFeatures(feature_options), 0.f);
   out.ordr.assign(n, 0.f);
-  const ProposalFeatureComputer computer(image, oaocc, regions, proposals,
-                                         FeatureOptionsForFrame(bundle, image.cols, image.rows),
+  const ProposalFeatureComputer computer(image, oaocc, regions, proposals, feature_options,
                                          limits.threads);
   std::size_t done = 0;
   Clock::duration feature_time{};

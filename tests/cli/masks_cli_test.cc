@@ -457,3 +457,53 @@ TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
 }
 
 }  // namespace
+
+namespace {
+
+// Proposal feature 21 (the vertical edge share): `tod train` adds it by default and records it,
+// --no-vertical-edge-feature keeps the paper's 20; both bundles detect, with different scores,
+// and a manifest that claims the other feature set than its forests is refused when loaded.
+TEST_F(MasksCliTest, VerticalEdgeFeatureByDefaultPaperFeaturesOnRequest) {
+  const std::string with = (out_ / "with").string(), paper = (out_ / "paper").string();
+  const CommandResult with_run = RunCommand(Train(with, "--no-map-isolation"));
+  ASSERT_EQ(with_run.exit_code, 0) << with_run.output;
+  const CommandResult paper_run =
+      RunCommand(Train(paper, "--no-map-isolation --no-vertical-edge-feature"));
+  ASSERT_EQ(paper_run.exit_code, 0) << paper_run.output;
+  EXPECT_EQ(Manifest(with)["params"]["vertical_edge_feature"], true);
+  EXPECT_EQ(Manifest(paper)["params"]["vertical_edge_feature"], false);
+  for (const char* regressor : {"ordr", "obdr"}) {
+    EXPECT_EQ(Manifest(with)["training"]["parts"][regressor]["features"], 21) << regressor;
+    EXPECT_EQ(Manifest(paper)["training"]["parts"][regressor]["features"], 20) << regressor;
+  }
+  // The edge and occlusion classifiers do not see the proposals' features.
+  EXPECT_EQ(Manifest(with)["files"]["occlusion.bin"]["fnv1a64"],
+            Manifest(paper)["files"]["occlusion.bin"]["fnv1a64"]);
+
+  const std::string image = Root() + "/images/2.png";
+  nlohmann::json proposals[2];
+  for (int k = 0; k < 2; ++k) {
+    const fs::path out = out_ / (k == 0 ? "detect_with" : "detect_paper");
+    const CommandResult detect = RunCommand(tod_ + " detect --model " + (k == 0 ? with : paper) +
+                                            " --out " + out.string() + " " + image);
+    ASSERT_EQ(detect.exit_code, 0) << detect.output;
+    std::ifstream json(out / "2.json");
+    proposals[k] = nlohmann::json::parse(json)["proposals"];
+    ASSERT_FALSE(proposals[k].empty());
+  }
+  EXPECT_NE(proposals[0], proposals[1]);
+
+  // The paper bundle's manifest made to claim the 21st feature: its 20-feature forests are
+  // refused by name, not read shifted.
+  const fs::path forged = out_ / "forged";
+  fs::copy(paper, forged, fs::copy_options::recursive);
+  nlohmann::json manifest = Manifest(forged.string());
+  manifest["params"]["vertical_edge_feature"] = true;
+  std::ofstream(forged / "manifest.json") << manifest.dump(2);
+  const CommandResult refused = RunCommand(tod_ + " detect --model " + forged.string() + " --out " +
+                                           (out_ / "detect_forged").string() + " " + image);
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.output.find("must take 21 features"), std::string::npos) << refused.output;
+}
+
+}  // namespace
