@@ -273,14 +273,26 @@ namespace {
 
 // Without a road label (obstacle-mask benchmarks) `road` is every non-obstacle pixel: both
 // regressors draw their negatives from the same non-obstacle pool, independently.
-TEST(SampleSelectionTest, WithoutRoadLabelBothRegressorsDrawFromEveryNonObstacleBox) {
+// RoadWithOneObstacle as an obstacle-mask benchmark has it: every non-obstacle pixel is free.
+Sample WithoutRoadLabel() {
   Sample gt = RoadWithOneObstacle();
   gt.free_space = FreeSpace::kNotObstacle;
   gt.road.setTo(255);
   gt.road(gt.instances[0].box.rect()).setTo(0);
+  return gt;
+}
+
+// 10 x 10 boxes over the 100 x 100 frame every `step_x`, `step_y` pixels.
+std::vector<ScoredBox> GridOfBoxes(int step_x, int step_y) {
   std::vector<ScoredBox> proposals;
-  for (int y = 0; y + 10 <= 100; y += 10)
-    for (int x = 0; x + 10 <= 100; x += 10) proposals.push_back({{x, y, 10, 10}, 0.1f});
+  for (int y = 0; y + 10 <= 100; y += step_y)
+    for (int x = 0; x + 10 <= 100; x += step_x) proposals.push_back({{x, y, 10, 10}, 0.1f});
+  return proposals;
+}
+
+TEST(SampleSelectionTest, WithoutRoadLabelBothRegressorsDrawFromEveryNonObstacleBox) {
+  const Sample gt = WithoutRoadLabel();
+  const std::vector<ScoredBox> proposals = GridOfBoxes(10, 10);
   auto selected = SelectTrainingSamples(proposals, gt, kLimits, SmallParams(), 3);
   ASSERT_TRUE(selected.ok()) << selected.status().message();
   const std::size_t positives = selected->positive_indices.size();
@@ -289,22 +301,11 @@ TEST(SampleSelectionTest, WithoutRoadLabelBothRegressorsDrawFromEveryNonObstacle
   EXPECT_NE(selected->ordr_indices, selected->obdr_indices);  // independent draws
 }
 
-}  // namespace
-}  // namespace tod
-
-namespace tod {
-namespace {
-
 // Balanced bagging: each bag is a draw of the paper's counts, disjoint from the other bags';
 // positives belong to every bag; one bag is the paper's draw, row for row.
 TEST(SampleSelectionTest, NegativeBagsAreDisjointDrawsOfTheSameCounts) {
-  Sample gt = RoadWithOneObstacle();
-  gt.free_space = FreeSpace::kNotObstacle;
-  gt.road.setTo(255);
-  gt.road(gt.instances[0].box.rect()).setTo(0);
-  std::vector<ScoredBox> proposals;
-  for (int y = 0; y + 10 <= 100; y += 2)
-    for (int x = 0; x + 10 <= 100; x += 5) proposals.push_back({{x, y, 10, 10}, 0.1f});
+  const Sample gt = WithoutRoadLabel();
+  const std::vector<ScoredBox> proposals = GridOfBoxes(5, 2);
   SampleSelectionParams params = SmallParams();
   params.ordr_negatives = {6, 6};
   params.obdr_negatives = {4, 4};

@@ -32,19 +32,24 @@ cv::Mat3b Bar(int size, double degrees, int width) {
 // The definition of vertical_edges.h, pixel by pixel, over a crop-local rectangle.
 double BruteForceShare(const cv::Mat3b& bgr, const cv::Rect& rect,
                        const VerticalEdgeParams& params = {}) {
-  cv::Mat1b grey8;
-  cv::cvtColor(bgr, grey8, cv::COLOR_BGR2GRAY);
-  cv::Mat1f grey, gx, gy;
-  grey8.convertTo(grey, CV_32F);
-  cv::Sobel(grey, gx, CV_32F, 1, 0, 3);
-  cv::Sobel(grey, gy, CV_32F, 0, 1, 3);
+  cv::Mat1b grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  // 3 x 3 Sobel written out, the border reflected without repeating the edge pixel.
+  const auto at = [&grey](int y, int x) {
+    const auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };
+    return static_cast<float>(grey(reflect(y, grey.rows), reflect(x, grey.cols)));
+  };
   double vertical = 0, counted = 0;
   for (int y = rect.y; y < rect.y + rect.height; ++y)
     for (int x = rect.x; x < rect.x + rect.width; ++x) {
-      const double m = std::hypot(gx(y, x), gy(y, x));  // in float, as the tables
+      const float gx = (at(y - 1, x + 1) + 2 * at(y, x + 1) + at(y + 1, x + 1)) -
+                       (at(y - 1, x - 1) + 2 * at(y, x - 1) + at(y + 1, x - 1));
+      const float gy = (at(y + 1, x - 1) + 2 * at(y + 1, x) + at(y + 1, x + 1)) -
+                       (at(y - 1, x - 1) + 2 * at(y - 1, x) + at(y - 1, x + 1));
+      const double m = std::hypot(gx, gy);  // in float, as the tables
       if (m < params.min_gradient) continue;
       counted += m;
-      const double tilt = std::asin(std::min(1.0, std::abs(gy(y, x)) / m)) * 180.0 / CV_PI;
+      const double tilt = std::asin(std::min(1.0, std::abs(gy) / m)) * 180.0 / CV_PI;
       if (tilt < params.max_tilt_degrees) vertical += m;
     }
   return counted > 0 ? vertical / counted : 0.0;
