@@ -43,6 +43,16 @@ Status ValidateInput(const cv::Mat1f& region_map, const cv::Mat3b& region_bgr,
   return ValidateGeometry(region_map.size(), region_origin, image_size);
 }
 
+// The region [region_origin, + region_size) must lie inside a shared table's crop.
+Status RegionInsideCrop(cv::Size region_size, cv::Point region_origin, cv::Size crop_size,
+                        cv::Point crop_origin, const char* table) {
+  const cv::Rect region(region_origin, region_size);
+  if ((region & cv::Rect(crop_origin, crop_size)) == region) return Status::Ok();
+  return Status::InvalidArgument(
+      "BoxFeatureExtractor: region_map " + PlaceText(region_size, region_origin) +
+      " does not lie inside the " + table + " crop " + PlaceText(crop_size, crop_origin));
+}
+
 Status ValidateShared(const ColourIntegrals* frame_colour, const cv::Mat1f& region_map,
                       cv::Point region_origin, cv::Size image_size) {
   if (frame_colour == nullptr) {
@@ -52,15 +62,8 @@ Status ValidateShared(const ColourIntegrals* frame_colour, const cv::Mat1f& regi
       !geometry.ok()) {
     return geometry;
   }
-  const cv::Rect colour_crop(frame_colour->origin(), frame_colour->size());
-  const cv::Rect region(region_origin, region_map.size());
-  if ((region & colour_crop) != region) {
-    return Status::InvalidArgument("BoxFeatureExtractor: region_map " +
-                                   PlaceText(region_map.size(), region_origin) +
-                                   " does not lie inside the frame_colour crop " +
-                                   PlaceText(frame_colour->size(), frame_colour->origin()));
-  }
-  return Status::Ok();
+  return RegionInsideCrop(region_map.size(), region_origin, frame_colour->size(),
+                          frame_colour->origin(), "frame_colour");
 }
 
 Status ValidateVertical(const VerticalEdgeIntegrals* frame_vertical,
@@ -72,15 +75,8 @@ Status ValidateVertical(const VerticalEdgeIntegrals* frame_vertical,
         "BoxFeatureExtractor: options.vertical_edges needs the frame's vertical-edge tables "
         "(frame_vertical is null)");
   }
-  const cv::Rect crop(frame_vertical->origin(), frame_vertical->size());
-  const cv::Rect region(region_origin, region_map.size());
-  if ((region & crop) != region) {
-    return Status::InvalidArgument("BoxFeatureExtractor: region_map " +
-                                   PlaceText(region_map.size(), region_origin) +
-                                   " does not lie inside the frame_vertical crop " +
-                                   PlaceText(frame_vertical->size(), frame_vertical->origin()));
-  }
-  return Status::Ok();
+  return RegionInsideCrop(region_map.size(), region_origin, frame_vertical->size(),
+                          frame_vertical->origin(), "frame_vertical");
 }
 
 // Sort key of a box for ComputeAll: tiles of 64 x 64 pixels (by the box centre) in row-major
