@@ -764,6 +764,12 @@ cv::Mat1i LabelMap(const Sample& sample) {
 }
 
 Result<ModelBundle> TrainModel(const TrainOptions& options) {
+  // Each negative bag is a forest of its own (FitBaggedRegressor): checked before any work.
+  if (options.selection.negative_bags > options.regressor.num_trees)
+    return Status::InvalidArgument(
+        "--negative-bags " + std::to_string(options.selection.negative_bags) +
+        " is more than the regressors' " + std::to_string(options.regressor.num_trees) +
+        " trees: every bag needs a tree of its own");
   TrainingRun run(options);
   if (Status st = run.Open(); !st.ok()) return st;
   ModelBundle bundle;

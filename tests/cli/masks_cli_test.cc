@@ -223,6 +223,13 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
         << wrong.output;
     EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
   }
+  // Every bag is a forest of its own, so there cannot be more bags than trees (10 here).
+  const CommandResult too_many = RunCommand(Train((out_ / "wrong").string(), "--negative-bags 11"));
+  EXPECT_NE(too_many.exit_code, 0);
+  EXPECT_NE(too_many.output.find("--negative-bags 11 is more than the regressors' 10 trees"),
+            std::string::npos)
+      << too_many.output;
+  EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
 }
 
 // --box-size-features (proposal features 10, 12, 13) and --occlusion-size-features (the
