@@ -247,6 +247,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   report.reported = alarms;
   report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;
   report.map_superpixel_shares = bundle.params.probability_map.superpixel_shares;
+  report.proposal_features = bundle.ordr.num_features();
   report.free_space = road_labelled && not_obstacle
                           ? "mixed: the road label where the frame has one, else every non-void "
                             "non-obstacle pixel"
@@ -293,6 +294,7 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
   j["free_space"] = r.free_space;
   j["map_isolation_exponent"] = r.map_isolation_exponent;
   j["map_superpixel_shares"] = r.map_superpixel_shares;
+  j["proposal_features"] = r.proposal_features;
   auto ar = [](const VariantCurves& c) {
     nlohmann::json a = nlohmann::json::object();
     for (const auto& [n, v] : c.ar_table) a[std::to_string(n)] = v;
@@ -335,6 +337,8 @@ std::string FormatEvalTables(const EvalReport& r) {
     << (r.map_superpixel_shares ? ", each pixel by its superpixel's share of the box"
                                 : ", whole boxes")
     << "\n";
+  o << "regressors: " << r.proposal_features << " proposal features"
+    << (r.proposal_features > 20 ? " (the paper's 20 and the vertical edge share)" : "") << "\n";
   {
     const ReportedObstacleCounts& a = r.reported;
     char text[256];

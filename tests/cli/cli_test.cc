@@ -226,6 +226,12 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
                    manifest["params"]["probability_map"]["isolation"]["exponent"].get<double>());
   EXPECT_EQ(j["map_superpixel_shares"], manifest["params"]["probability_map"]["superpixel_shares"]);
   EXPECT_NE(run.output.find("paper's map: "), std::string::npos) << run.output;
+  // And which features the regressors read.
+  EXPECT_EQ(j["proposal_features"],
+            manifest["params"].value("vertical_edge_feature", false) ? 21 : 20);
+  EXPECT_NE(run.output.find("regressors: " + j["proposal_features"].dump() + " proposal features"),
+            std::string::npos)
+      << run.output;
 }
 
 TEST_F(CliTest, BrokenModelIsRefusedWithTheFileNamed) {
