@@ -152,6 +152,10 @@ Runner AddTrainCommand(CLI::App& app) {
                 "give the regressors a 21st proposal feature, the share of the box's strong "
                 "gradient on near-vertical edges (the default; --no-vertical-edge-feature: the "
                 "paper's 20 features)");
+  cmd->add_flag("--orientation-entropy-feature,!--no-orientation-entropy-feature",
+                args->train.params.orientation_entropy_feature,
+                "give the regressors one more proposal feature, the orientation entropy of the "
+                "box's strong gradients (--no-orientation-entropy-feature: without it)");
   cmd->add_flag("--no-eval", args->no_eval, "do not evaluate the new bundle on the test split");
   cmd->add_option("--eval-split", args->eval_split, "split evaluated after training");
   cmd->add_option("--eval-frames", args->eval_frames,

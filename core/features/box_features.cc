@@ -69,12 +69,17 @@ Status ValidateShared(const ColourIntegrals* frame_colour, const cv::Mat1f& regi
 Status ValidateVertical(const VerticalEdgeIntegrals* frame_vertical,
                         const BoxFeatureOptions& options, const cv::Mat1f& region_map,
                         cv::Point region_origin) {
-  if (!options.vertical_edges) return Status::Ok();
+  if (!options.vertical_edges && !options.orientation_entropy) return Status::Ok();
   if (frame_vertical == nullptr) {
     return Status::InvalidArgument(
-        "BoxFeatureExtractor: options.vertical_edges needs the frame's vertical-edge tables "
+        "BoxFeatureExtractor: options.vertical_edges / orientation_entropy need the frame's "
+        "vertical-edge tables "
         "(frame_vertical is null)");
   }
+  if (options.orientation_entropy && !frame_vertical->has_orientation_tables())
+    return Status::InvalidArgument(
+        "BoxFeatureExtractor: options.orientation_entropy needs frame_vertical built with "
+        "orientation tables");
   return RegionInsideCrop(region_map.size(), region_origin, frame_vertical->size(),
                           frame_vertical->origin(), "frame_vertical");
 }
@@ -115,8 +120,10 @@ BoxFeatureExtractor::BoxFeatureExtractor(const cv::Mat1f& region_map, const cv::
   if (!status_.ok()) return;
   colour_ = std::make_shared<const ColourIntegrals>(region_bgr, region_origin);
   region_in_colour_ = cv::Rect(cv::Point(0, 0), region_map.size());
-  if (options_.vertical_edges)
-    vertical_ = std::make_shared<const VerticalEdgeIntegrals>(region_bgr, region_origin);
+  if (options_.vertical_edges || options_.orientation_entropy)
+    vertical_ = std::make_shared<const VerticalEdgeIntegrals>(
+        region_bgr, region_origin,
+        VerticalEdgeParams{.orientation_tables = options_.orientation_entropy});
 }
 
 BoxFeatureExtractor::BoxFeatureExtractor(
@@ -134,7 +141,7 @@ BoxFeatureExtractor::BoxFeatureExtractor(
   if (!status_.ok()) return;
   region_in_colour_ = cv::Rect(region_origin - frame_colour->origin(), region_map.size());
   colour_ = std::move(frame_colour);
-  if (options_.vertical_edges) {
+  if (options_.vertical_edges || options_.orientation_entropy) {
     region_in_vertical_ = region_origin - frame_vertical->origin();
     vertical_ = std::move(frame_vertical);
   }
@@ -222,8 +229,11 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
   const cv::Point to_colour = region_in_colour_.tl();
   cv::Rect box_in_colour(r.tl() + to_colour, r.size());
   const ColourMoments moments = colour_->Moments(box_in_colour);
-  if (vertical_)
-    f[20] = static_cast<float>(vertical_->Share({r.tl() + region_in_vertical_, r.size()}));
+  const cv::Rect box_in_vertical(r.tl() + region_in_vertical_, r.size());
+  if (options_.vertical_edges) f[20] = static_cast<float>(vertical_->Share(box_in_vertical));
+  if (options_.orientation_entropy)
+    f[options_.vertical_edges ? 21 : 20] =
+        static_cast<float>(vertical_->OrientationEntropy(box_in_vertical));
   for (int c = 0; c < 3; ++c) {
     const double mean = moments[c] / area;
     const double variance = moments[3 + c] / area - mean * mean;

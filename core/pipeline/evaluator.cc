@@ -338,7 +338,11 @@ std::string FormatEvalTables(const EvalReport& r) {
                                 : ", whole boxes")
     << "\n";
   o << "regressors: " << r.proposal_features << " proposal features"
-    << (r.proposal_features > 20 ? " (the paper's 20 and the vertical edge share)" : "") << "\n";
+    << (r.proposal_features == 21   ? " (the paper's 20 and the vertical edge share)"
+        : r.proposal_features == 22 ? " (the paper's 20, the vertical edge share and the "
+                                      "orientation entropy)"
+                                    : "")
+    << "\n";
   {
     const ReportedObstacleCounts& a = r.reported;
     char text[256];

@@ -60,6 +60,7 @@ double MappedRow(const ModelBundle& bundle, int width, int height, double row) {
 BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height) {
   BoxFeatureOptions options;
   options.vertical_edges = bundle.params.vertical_edge_feature;
+  options.orientation_entropy = bundle.params.orientation_entropy_feature;
   const GroundPlaneFeatureParams& params = bundle.params.box_features;
   if (params.ground_plane_size)
     options.horizon_y = MappedRow(bundle, width, height, params.horizon_y);

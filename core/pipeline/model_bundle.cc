@@ -236,12 +236,14 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
   }
   // The manifest's feature set decides the row width; a forest of the other width was trained on
   // other features, and reading its rows shifted would be silently wrong.
-  const int features = bundle.params.vertical_edge_feature ? kMaxBoxFeatures : kNumBoxFeatures;
+  const int features = ProposalFeatureCount(bundle.params);
   if (bundle.ordr.num_features() != features || bundle.obdr.num_features() != features)
     return Status::DataLoss((root / kOrdrFile).string() + ": regressors must take " +
                             std::to_string(features) + " features (params.vertical_edge_feature " +
-                            (bundle.params.vertical_edge_feature ? "true" : "false") + "), not " +
-                            std::to_string(bundle.ordr.num_features()) + " / " +
+                            (bundle.params.vertical_edge_feature ? "true" : "false") +
+                            ", params.orientation_entropy_feature " +
+                            (bundle.params.orientation_entropy_feature ? "true" : "false") +
+                            "), not " + std::to_string(bundle.ordr.num_features()) + " / " +
                             std::to_string(bundle.obdr.num_features()));
   return bundle;
 }

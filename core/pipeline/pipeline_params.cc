@@ -37,7 +37,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradien
                                                 region_merge_iou, prior_correction, edge_screening,
                                                 occlusion_screening, obstacle_calibration, fusion,
                                                 probability_map, box_features, occlusion_features,
-                                                vertical_edge_feature)
+                                                vertical_edge_feature, orientation_entropy_feature)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
 
@@ -81,6 +81,10 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
         "edge_screening / occlusion_screening: trees >= 0, final_at_most in [0, 1), "
         "box_features.horizon_y and occlusion_features.horizon_y finite)");
   return p;
+}
+
+int ProposalFeatureCount(const PipelineParams& params) {
+  return 20 + (params.vertical_edge_feature ? 1 : 0) + (params.orientation_entropy_feature ? 1 : 0);
 }
 
 PipelineParams TrainingDefaultParams() {

@@ -91,7 +91,15 @@ struct PipelineParams {
   // features, so a bundle whose manifest predates it keeps its regressors' rows; `tod train`
   // turns it on (TrainingDefaultParams).
   bool vertical_edge_feature = false;
+  // One more proposal feature after those (22nd, or 21st without vertical_edge_feature): the
+  // orientation entropy of a box's strong gradients (ours; vertical_edges.h, README "Real
+  // frames", point 21). false, the default, so a bundle whose manifest predates it keeps its
+  // regressors' rows.
+  bool orientation_entropy_feature = false;
 };
+
+// The proposal features the regressors of a bundle with these parameters read: 20, 21 or 22.
+int ProposalFeatureCount(const PipelineParams& params);
 
 // The parameters `tod train` gives a new bundle: the defaults above, with the occlusion
 // classifier's early exit at {25 trees, 0.05}. A pair whose first 25 of 400 trees average at

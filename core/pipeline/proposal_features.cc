@@ -21,9 +21,12 @@ ProposalFeatureComputer::ProposalFeatureComputer(const cv::Mat3b& image,
   const cv::Mat3b r1_bgr = image(oaocc.r1.rect());
   const cv::Point r1_origin(oaocc.r1.x, oaocc.r1.y);
   const auto frame_colour = std::make_shared<const ColourIntegrals>(r1_bgr, r1_origin);
-  const auto frame_vertical = options.vertical_edges
-                                  ? std::make_shared<const VerticalEdgeIntegrals>(r1_bgr, r1_origin)
-                                  : nullptr;
+  const auto frame_vertical =
+      options.vertical_edges || options.orientation_entropy
+          ? std::make_shared<const VerticalEdgeIntegrals>(
+                r1_bgr, r1_origin,
+                VerticalEdgeParams{.orientation_tables = options.orientation_entropy})
+          : nullptr;
   // Each region's edge tables are one pass over its map, independent of the others.
   for (const Status& s : ParallelFor(regions.num_layers(), threads, [&](int k) {
          if (!used[k]) return Status::Ok();

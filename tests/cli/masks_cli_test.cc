@@ -513,4 +513,36 @@ TEST_F(MasksCliTest, VerticalEdgeFeatureByDefaultPaperFeaturesOnRequest) {
   EXPECT_NE(refused.output.find("must take 21 features"), std::string::npos) << refused.output;
 }
 
+// The orientation entropy (ours, measured and not adopted: README "Real frames", point 21) is an
+// option: `tod train --orientation-entropy-feature` records it, its forests read 22 features,
+// `tod detect` serves with it, and the manifest without the flag is refused by name.
+TEST_F(MasksCliTest, OrientationEntropyFeatureOnRequest) {
+  const std::string model = (out_ / "entropy").string();
+  const CommandResult run =
+      RunCommand(Train(model, "--no-map-isolation --orientation-entropy-feature"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(Manifest(model)["params"]["orientation_entropy_feature"], true);
+  EXPECT_EQ(Manifest(model)["params"]["vertical_edge_feature"], true);
+  for (const char* regressor : {"ordr", "obdr"})
+    EXPECT_EQ(Manifest(model)["training"]["parts"][regressor]["features"], 22) << regressor;
+
+  const std::string image = Root() + "/images/2.png";
+  const fs::path out = out_ / "detect_entropy";
+  const CommandResult detect =
+      RunCommand(tod_ + " detect --model " + model + " --out " + out.string() + " " + image);
+  ASSERT_EQ(detect.exit_code, 0) << detect.output;
+  std::ifstream json(out / "2.json");
+  EXPECT_FALSE(nlohmann::json::parse(json)["proposals"].empty());
+
+  const fs::path forged = out_ / "forged_entropy";
+  fs::copy(model, forged, fs::copy_options::recursive);
+  nlohmann::json manifest = Manifest(forged.string());
+  manifest["params"]["orientation_entropy_feature"] = false;
+  std::ofstream(forged / "manifest.json") << manifest.dump(2);
+  const CommandResult refused = RunCommand(tod_ + " detect --model " + forged.string() + " --out " +
+                                           (out_ / "detect_forged_entropy").string() + " " + image);
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.output.find("must take 21 features"), std::string::npos) << refused.output;
+}
+
 }  // namespace
