@@ -64,6 +64,9 @@ Runner AddTrainCommand(CLI::App& app) {
                   "regressor negatives per frame and vertical range, as a multiple of the "
                   "paper's (ORDR 17, OBDR 25)")
       ->check(CLI::Range(0.1, 20.0));
+  cmd->add_option("--hard-fraction", args->train.selection.hard_fraction,
+                  "share of the regressors' negatives drawn as hard ones (tau_l; paper: 0.2)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--negative-bags", args->train.selection.negative_bags,
                   "regressors: draw the negatives N times (disjoint draws of the paper's counts) "
                   "and fit each regressor as N forests of trees/N, each on every positive and "

@@ -814,6 +814,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
         {"negatives_per_range", std::string(name) == "ordr" ? options.selection.ordr_negatives
                                                             : options.selection.obdr_negatives},
         {"negative_bags", options.selection.negative_bags},
+        {"hard_fraction", options.selection.hard_fraction},
         {"features", bundle.ordr.num_features()},
         {"maps", folds.enabled ? "out_of_fold" : "in_sample"},
         {"fold_layout", FoldLayoutName(options.fold_layout)}};

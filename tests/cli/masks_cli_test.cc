@@ -186,7 +186,7 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
             "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2 --superpixel-strips 16 "
             "--edge-negatives 3 --occlusion-negatives 6 --occlusion-screen-trees 3 "
             "--occlusion-screen-below 0.25 --negative-bags 2 --regressor-mtry 4 "
-            "--regressor-min-leaf 7"));
+            "--regressor-min-leaf 7 --hard-fraction 0.5"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json manifest = Manifest(model);
   for (const char* regressor : {"ordr", "obdr"}) {
@@ -194,6 +194,7 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
     EXPECT_EQ(part["negative_bags"], 2) << regressor;
     EXPECT_EQ(part["mtry"], 4) << regressor;
     EXPECT_EQ(part["min_leaf"], 7) << regressor;
+    EXPECT_EQ(part["hard_fraction"], 0.5) << regressor;
     EXPECT_EQ(part["trees"], 10) << regressor;  // two bags of 5 trees, joined
   }
   const auto bundle = tod::LoadModelBundle(model);
@@ -215,7 +216,8 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   for (const char* flag :
        {"--edge-trees 0", "--negatives-scale 0", "--superpixel-strips -1", "--edge-negatives 0",
         "--occlusion-negatives 0", "--occlusion-screen-trees -1", "--occlusion-screen-below 1",
-        "--negative-bags 0", "--regressor-mtry 0", "--regressor-min-leaf 0"}) {
+        "--negative-bags 0", "--regressor-mtry 0", "--regressor-min-leaf 0",
+        "--hard-fraction 1.5"}) {
     const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), flag));
     EXPECT_NE(wrong.exit_code, 0) << flag;
     EXPECT_NE(wrong.output.find(std::string(flag).substr(0, std::string(flag).find(' '))),
