@@ -144,8 +144,10 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
       bp_ordr[j] = {bp_reg.proposals.boxes[j].box, bp_reg.ordr[j]};
     }
     const MapSuperpixels superpixels{oaocc.superpixels, oaocc.r1};
-    Result<cv::Mat1f> fusion_made = AccumulateProbabilityMap(
-        bp_fusion, s.image.size(), bundle.params.probability_map, &superpixels);
+    const MapAccumulation fusion_boxes = AccumulatedBoxes(bp_fusion, bundle.params.probability_map);
+    Result<cv::Mat1f> fusion_made =
+        PaintProbabilityMap(fusion_boxes, s.image.size(),
+                            bundle.params.probability_map.superpixel_shares, &superpixels);
     if (!fusion_made.ok()) return fusion_made.status();
     const cv::Mat1f map_fusion = std::move(fusion_made).value();
     timer.Mark("probability_map");
@@ -168,8 +170,8 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const float min_score = bundle.params.probability_map.min_score;
     cv::Mat1f map_calibrated;
     if (calibrated_map) {
-      Result<cv::Mat1f> made = ServedProbabilityMap(bp_fusion, s.image.size(), oaocc, bundle.params,
-                                                    MapKind::kCalibrated);
+      Result<cv::Mat1f> made = ServedProbabilityMap(bp_fusion, fusion_boxes, s.image.size(), oaocc,
+                                                    bundle.params, MapKind::kCalibrated);
       if (!made.ok()) return made.status();
       map_calibrated = std::move(*made);
     }
@@ -177,11 +179,11 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     // Reported obstacles at the detector's defaults (calibrated score >= 0.5), from the map the
     // detector takes them from.
     Result<cv::Mat1f> obstacle_made = ObstacleComponentsMap(
-        bp_fusion, s.image.size(), bundle.params, MapKind::kNormalized, map_fusion);
+        fusion_boxes, s.image.size(), bundle.params, MapKind::kNormalized, map_fusion);
     if (!obstacle_made.ok()) return obstacle_made.status();
     const cv::Mat1f obstacle_map = std::move(obstacle_made).value();
     const std::vector<DetectedObstacle> reported =
-        ScoreObstacles(obstacle_map, bp_fusion, bundle.params, DetectOptions{});
+        ScoreObstacles(obstacle_map, fusion_boxes.boxes, bundle.params, DetectOptions{});
     int false_alarms = 0;
     for (const DetectedObstacle& o : reported)
       false_alarms += cv::countNonZero(s.obstacle(o.box.rect())) == 0;

@@ -20,18 +20,23 @@ Status MapIsolationFit::AddFrame(int frame, const Sample& sample, const MapSuper
                                  const std::vector<ScoredBox>& fused) {
   DetectOptions every_component;
   every_component.min_obstacle_score = -1.f;
+  // The map's boxes do not depend on the weights: found once, weighed per candidate.
+  const std::vector<ScoredBox> map_boxes = MapBoxes(fused, params_.probability_map);
   for (std::size_t c = 0; c < exponents_.size(); ++c) {
     PipelineParams params = params_;
     params.probability_map.isolation.exponent = exponents_[c];
-    Result<cv::Mat1f> made =
-        AccumulateProbabilityMap(fused, sample.image.size(), params.probability_map, &superpixels);
+    const MapAccumulation accumulated =
+        WeighMapBoxes(map_boxes, fused, params.probability_map.isolation);
+    Result<cv::Mat1f> made = PaintProbabilityMap(
+        accumulated, sample.image.size(), params.probability_map.superpixel_shares, &superpixels);
     if (!made.ok()) return made.status();
     const cv::Mat1f& map = *made;
     const Result<cv::Mat1f> components =
-        ObstacleComponentsMap(fused, sample.image.size(), params, MapKind::kNormalized, map);
+        ObstacleComponentsMap(accumulated, sample.image.size(), params, MapKind::kNormalized, map);
     if (!components.ok()) return components.status();
     std::vector<std::pair<double, int>> found;
-    for (const DetectedObstacle& o : ScoreObstacles(*components, fused, params, every_component))
+    for (const DetectedObstacle& o :
+         ScoreObstacles(*components, accumulated.boxes, params, every_component))
       found.emplace_back(o.evidence, cv::countNonZero(sample.obstacle(o.box.rect())) > 0 ? 1 : 0);
     std::lock_guard lock(mutex_);
     if (Status st = pixels_[c].Add(map, sample.obstacle, sample.road); !st.ok()) return st;

@@ -9,10 +9,9 @@
 namespace tod {
 
 std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
-                                             const std::vector<ScoredBox>& fused_boxes,
+                                             const std::vector<ScoredBox>& map_boxes,
                                              const PipelineParams& params,
                                              const DetectOptions& options) {
-  const std::vector<ScoredBox> map_boxes = MapBoxes(fused_boxes, params.probability_map);
   std::vector<DetectedObstacle> out;
   for (const ObstacleComponent& c : ThresholdObstacles(probability, options.obstacle_threshold)) {
     const float evidence = ObstacleEvidence(c.box, map_boxes);
@@ -24,22 +23,22 @@ std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
 }
 
 Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
-                                       cv::Size image_size, const OcclusionEdges& oaocc,
-                                       const PipelineParams& params, MapKind kind) {
+                                       const MapAccumulation& accumulated, cv::Size image_size,
+                                       const OcclusionEdges& oaocc, const PipelineParams& params,
+                                       MapKind kind) {
   if (kind == MapKind::kCalibrated)
     return CalibratedProbabilityMap(fused_boxes, image_size, params.obstacle_calibration,
                                     oaocc.superpixels, oaocc.r1);
   const MapSuperpixels superpixels{oaocc.superpixels, oaocc.r1};
-  return AccumulateProbabilityMap(fused_boxes, image_size, params.probability_map, &superpixels);
+  return PaintProbabilityMap(accumulated, image_size, params.probability_map.superpixel_shares,
+                             &superpixels);
 }
 
-Result<cv::Mat1f> ObstacleComponentsMap(const std::vector<ScoredBox>& fused_boxes,
-                                        cv::Size image_size, const PipelineParams& params,
-                                        MapKind kind, const cv::Mat1f& served) {
+Result<cv::Mat1f> ObstacleComponentsMap(const MapAccumulation& accumulated, cv::Size image_size,
+                                        const PipelineParams& params, MapKind kind,
+                                        const cv::Mat1f& served) {
   if (kind != MapKind::kNormalized || !params.probability_map.superpixel_shares) return served;
-  ProbabilityMapParams whole_boxes = params.probability_map;
-  whole_boxes.superpixel_shares = false;
-  return AccumulateProbabilityMap(fused_boxes, image_size, whole_boxes);
+  return PaintProbabilityMap(accumulated, image_size, /*superpixel_shares=*/false);
 }
 
 namespace {
@@ -126,16 +125,17 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   std::vector<ScoredBox> scored(fused.size());
   for (std::size_t i = 0; i < fused.size(); ++i)
     scored[i] = {regressed.proposals.boxes[i].box, fused[i]};
-  Result<cv::Mat1f> probability =
-      ServedProbabilityMap(scored, bgr.size(), oaocc, bundle_.params, options.map_kind);
+  const MapAccumulation accumulated = AccumulatedBoxes(scored, bundle_.params.probability_map);
+  Result<cv::Mat1f> probability = ServedProbabilityMap(scored, accumulated, bgr.size(), oaocc,
+                                                       bundle_.params, options.map_kind);
   if (!probability.ok()) return probability.status();
   out.map_kind = options.map_kind;
   out.width = bgr.cols;
   out.height = bgr.rows;
-  const Result<cv::Mat1f> components =
-      ObstacleComponentsMap(scored, bgr.size(), bundle_.params, options.map_kind, *probability);
+  const Result<cv::Mat1f> components = ObstacleComponentsMap(
+      accumulated, bgr.size(), bundle_.params, options.map_kind, *probability);
   if (!components.ok()) return components.status();
-  out.obstacles = ScoreObstacles(*components, scored, bundle_.params, options);
+  out.obstacles = ScoreObstacles(*components, accumulated.boxes, bundle_.params, options);
   timer.Mark("probability_map");
 
   std::vector<std::size_t> order(fused.size());

@@ -11,28 +11,30 @@
 
 namespace tod {
 
-// The obstacles of a frame: components of P > obstacle_threshold, each with its evidence and
-// calibrated score, those scoring below min_obstacle_score left out.
+// The obstacles of a frame: components of P > obstacle_threshold, each with its evidence (the
+// largest fused score of the map's boxes, MapAccumulation::boxes, over it) and calibrated score,
+// those scoring below min_obstacle_score left out.
 std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
-                                             const std::vector<ScoredBox>& fused_boxes,
+                                             const std::vector<ScoredBox>& map_boxes,
                                              const PipelineParams& params,
                                              const DetectOptions& options);
 
-// The map a detection serves: the paper's normalised sum (§7) or the calibrated map, from the
-// fused boxes of the frame (and, for the calibrated map, the superpixels of `oaocc`).
+// The map a detection serves: the paper's normalised sum (§7) of the frame's accumulated boxes,
+// or the calibrated map of its fused boxes (with the superpixels of `oaocc`).
 // FailedPrecondition for the calibrated map of a bundle without a fitted calibration.
 Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes,
-                                       cv::Size image_size, const OcclusionEdges& oaocc,
-                                       const PipelineParams& params, MapKind kind);
+                                       const MapAccumulation& accumulated, cv::Size image_size,
+                                       const OcclusionEdges& oaocc, const PipelineParams& params,
+                                       MapKind kind);
 
 // The map whose components are a frame's obstacles: `served` itself, except that for the
 // normalised map with superpixel shares it is the same boxes painted whole. Shares tighten a
 // map's pixels around each object, but they split the boxes' area into more and smaller
 // components, on which the obstacles' calibration fits lower scores (README "Real frames",
 // point 19): the obstacle list, and the calibration, stay those of the whole-box map.
-Result<cv::Mat1f> ObstacleComponentsMap(const std::vector<ScoredBox>& fused_boxes,
-                                        cv::Size image_size, const PipelineParams& params,
-                                        MapKind kind, const cv::Mat1f& served);
+Result<cv::Mat1f> ObstacleComponentsMap(const MapAccumulation& accumulated, cv::Size image_size,
+                                        const PipelineParams& params, MapKind kind,
+                                        const cv::Mat1f& served);
 
 class ObstacleDetector final : public Detector {
  public:

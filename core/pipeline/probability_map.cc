@@ -84,6 +84,12 @@ ScoreSum AccumulateWholeBoxes(const std::vector<ScoredBox>& kept, cv::Size image
   return out;
 }
 
+Status SharesHaveSuperpixels(bool superpixel_shares, const MapSuperpixels* superpixels) {
+  if (!superpixel_shares || superpixels != nullptr) return Status::Ok();
+  return Status::InvalidArgument(
+      "probability map: superpixel shares were asked for without the frame's superpixels");
+}
+
 ScoreSum AccumulateShares(const std::vector<ScoredBox>& kept, cv::Size image_size,
                           const MapSuperpixels& superpixels) {
   ScoreSum out{cv::Mat1f(image_size, 0.f)};
@@ -95,24 +101,45 @@ ScoreSum AccumulateShares(const std::vector<ScoredBox>& kept, cv::Size image_siz
 
 }  // namespace
 
+MapAccumulation WeighMapBoxes(std::vector<ScoredBox> map_boxes,
+                              const std::vector<ScoredBox>& frame_boxes,
+                              const BoxIsolationParams& isolation) {
+  MapAccumulation out;
+  out.weighted = map_boxes;
+  if (isolation.exponent != 0.f) {
+    const std::vector<float> weights = IsolationWeights(map_boxes, frame_boxes, isolation);
+    for (std::size_t i = 0; i < out.weighted.size(); ++i) out.weighted[i].score *= weights[i];
+  }
+  out.boxes = std::move(map_boxes);
+  return out;
+}
+
+MapAccumulation AccumulatedBoxes(const std::vector<ScoredBox>& boxes,
+                                 const ProbabilityMapParams& params) {
+  return WeighMapBoxes(MapBoxes(boxes, params), boxes, params.isolation);
+}
+
+Result<cv::Mat1f> PaintProbabilityMap(const MapAccumulation& accumulated, cv::Size image_size,
+                                      bool superpixel_shares, const MapSuperpixels* superpixels) {
+  if (Status ready = SharesHaveSuperpixels(superpixel_shares, superpixels); !ready.ok())
+    return ready;
+  ScoreSum painted = superpixel_shares
+                         ? AccumulateShares(accumulated.weighted, image_size, *superpixels)
+                         : AccumulateWholeBoxes(accumulated.weighted, image_size);
+  cv::Mat1f& prob = painted.sum;
+  if (painted.peak > 0) prob *= 1.0 / painted.peak;
+  cv::max(prob, 0.f, prob);  // rounding in the prefix sums must not leave tiny negatives
+  return prob;
+}
+
 Result<cv::Mat1f> AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
                                            const ProbabilityMapParams& params,
                                            const MapSuperpixels* superpixels) {
-  if (params.superpixel_shares && superpixels == nullptr) {
-    return Status::InvalidArgument(
-        "probability map: superpixel shares were asked for without the frame's superpixels");
-  }
-  std::vector<ScoredBox> kept = MapBoxes(boxes, params);
-  if (params.isolation.exponent != 0.f) {
-    const std::vector<float> weights = IsolationWeights(kept, boxes, params.isolation);
-    for (std::size_t i = 0; i < kept.size(); ++i) kept[i].score *= weights[i];
-  }
-  ScoreSum accumulated = params.superpixel_shares ? AccumulateShares(kept, image_size, *superpixels)
-                                                  : AccumulateWholeBoxes(kept, image_size);
-  cv::Mat1f& prob = accumulated.sum;
-  if (accumulated.peak > 0) prob *= 1.0 / accumulated.peak;
-  cv::max(prob, 0.f, prob);  // rounding in the prefix sums must not leave tiny negatives
-  return prob;
+  // Checked before the boxes are found, as PaintProbabilityMap checks again.
+  if (Status ready = SharesHaveSuperpixels(params.superpixel_shares, superpixels); !ready.ok())
+    return ready;
+  return PaintProbabilityMap(AccumulatedBoxes(boxes, params), image_size, params.superpixel_shares,
+                             superpixels);
 }
 
 Status CalibratedMapAvailable(const ObstacleCalibration& calibration) {

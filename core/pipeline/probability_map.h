@@ -62,12 +62,32 @@ std::vector<ScoredBox> MapBoxes(const std::vector<ScoredBox>& boxes,
 // obstacle's evidence before the map is normalised (obstacle_calibration.h).
 float ObstacleEvidence(const Box& component, const std::vector<ScoredBox>& map_boxes);
 
-// §7 steps 2-5: threshold, NMS, top fraction, accumulate per pixel (difference image + prefix
-// sums, so the cost is linear in boxes plus pixels), normalise by the maximum. With an isolation
-// exponent, each accumulated box adds its score times its isolation weight among `boxes`. With
-// params.superpixel_shares, each box adds its score times the superpixel share of each pixel
-// (two passes over the accumulated boxes' pixels), which needs the frame's `superpixels`:
-// InvalidArgument without them.
+// The boxes a frame's map accumulates, found once per frame and shared by the maps painted from
+// them and by the obstacles' evidence: `boxes` are §7 steps 2-4 (MapBoxes) with their fused
+// scores, `weighted` the same boxes with what each adds to the map, its score times its
+// isolation weight among the frame's boxes (box_isolation.h; the score itself at exponent 0).
+struct MapAccumulation {
+  std::vector<ScoredBox> boxes;
+  std::vector<ScoredBox> weighted;
+};
+// MapBoxes of `boxes`, weighed by their isolation among `boxes`.
+MapAccumulation AccumulatedBoxes(const std::vector<ScoredBox>& boxes,
+                                 const ProbabilityMapParams& params);
+// `map_boxes` (MapBoxes of `frame_boxes`) weighed by their isolation among `frame_boxes` under
+// `isolation`: a caller that tries several weights finds the map's boxes once.
+MapAccumulation WeighMapBoxes(std::vector<ScoredBox> map_boxes,
+                              const std::vector<ScoredBox>& frame_boxes,
+                              const BoxIsolationParams& isolation);
+
+// §7 step 4-5 on accumulated boxes: each weighted box adds its score per pixel (difference image
+// + prefix sums, so the cost is linear in boxes plus pixels), or with `superpixel_shares` its
+// score times the superpixel share of each pixel (two passes over the boxes' pixels), which
+// needs the frame's `superpixels` (InvalidArgument without them); then divided by the maximum.
+Result<cv::Mat1f> PaintProbabilityMap(const MapAccumulation& accumulated, cv::Size image_size,
+                                      bool superpixel_shares,
+                                      const MapSuperpixels* superpixels = nullptr);
+
+// §7 steps 2-5 in one call: AccumulatedBoxes, then PaintProbabilityMap with params' shares.
 Result<cv::Mat1f> AccumulateProbabilityMap(const std::vector<ScoredBox>& boxes, cv::Size image_size,
                                            const ProbabilityMapParams& params = {},
                                            const MapSuperpixels* superpixels = nullptr);

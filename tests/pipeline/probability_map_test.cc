@@ -85,6 +85,41 @@ TEST(ProbabilityMap, SuperpixelSharesWeighEachBoxsPixels) {
   EXPECT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
 }
 
+// A frame's accumulated boxes are found once and serve every map painted from them: the map's
+// boxes keep their fused scores (the obstacles' evidence), the weighted copy adds score times
+// isolation weight, and painting them gives the one-call map, whole or with shares.
+TEST(ProbabilityMap, AccumulatedBoxesServeEveryMapOfTheFrame) {
+  const auto same = [](const std::vector<ScoredBox>& a, const std::vector<ScoredBox>& b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
+      return x.box == y.box && x.score == y.score;
+    });
+  };
+  std::vector<ScoredBox> boxes;
+  for (int i = 0; i < 12; ++i)  // a stripe of similar boxes and a lone one
+    boxes.push_back({{4 + 5 * i, 20, 6, 6}, 0.6f + 0.01f * i});
+  boxes.push_back({{40, 2, 6, 6}, 0.65f});
+  ProbabilityMapParams params;
+  params.isolation.exponent = 2.f;
+  const MapAccumulation accumulated = AccumulatedBoxes(boxes, params);
+  EXPECT_TRUE(same(accumulated.boxes, MapBoxes(boxes, params)));
+  const std::vector<float> weights = IsolationWeights(accumulated.boxes, boxes, params.isolation);
+  ASSERT_EQ(accumulated.weighted.size(), accumulated.boxes.size());
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    EXPECT_EQ(accumulated.weighted[i].box, accumulated.boxes[i].box);
+    EXPECT_FLOAT_EQ(accumulated.weighted[i].score, accumulated.boxes[i].score * weights[i]);
+  }
+  EXPECT_LT(*std::min_element(weights.begin(), weights.end()), 1.f);  // the weights do weigh
+  const cv::Size size(70, 40);
+  const cv::Mat1f painted = PaintProbabilityMap(accumulated, size, false).value();
+  EXPECT_EQ(cv::norm(painted, AccumulateProbabilityMap(boxes, size, params).value(), cv::NORM_INF),
+            0.0);
+  // Exponent 0: the weighted copy is the map's boxes.
+  const MapAccumulation plain = WeighMapBoxes(accumulated.boxes, boxes, BoxIsolationParams{});
+  EXPECT_TRUE(same(plain.weighted, plain.boxes));
+  // Shares still need the superpixels.
+  EXPECT_FALSE(PaintProbabilityMap(accumulated, size, true).ok());
+}
+
 TEST(ProbabilityMap, NoBoxesGiveAnAllZeroMap) {
   const cv::Mat1f map = AccumulateProbabilityMap({}, {16, 8}).value();
   EXPECT_EQ(cv::countNonZero(map), 0);
