@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -76,6 +77,20 @@ class MasksCliTest : public ::testing::Test {
   static nlohmann::json Manifest(const std::string& model) {
     std::ifstream in(fs::path(model) / "manifest.json");
     return nlohmann::json::parse(in);
+  }
+
+  // `tod detect` on `image` with a copy of `model` (out_/name) whose manifest `edit` changed;
+  // its output goes to out_/detect_<name>.
+  CommandResult DetectForged(const std::string& model, const std::string& name,
+                             const std::function<void(nlohmann::json&)>& edit,
+                             const std::string& image) const {
+    const fs::path forged = out_ / name;
+    fs::copy(model, forged, fs::copy_options::recursive);
+    nlohmann::json manifest = Manifest(forged.string());
+    edit(manifest);
+    std::ofstream(forged / "manifest.json") << manifest.dump(2);
+    return RunCommand(tod_ + " detect --model " + forged.string() + " --out " +
+                      (out_ / ("detect_" + name)).string() + " " + image);
   }
 
   static fs::path* root_;
@@ -370,15 +385,15 @@ TEST_F(MasksCliTest, MapIsolationIsFittedByDefaultPaperMapOnRequest) {
   const std::string image = Root() + "/images/2.png";  // a frame of the set, with obstacles
   cv::Mat maps[2];
   for (const int exponent : {0, 4}) {
-    const fs::path copy = out_ / ("exponent_" + std::to_string(exponent));
-    fs::copy(paper, copy, fs::copy_options::recursive);
-    nlohmann::json manifest = Manifest(copy.string());
-    manifest["params"]["probability_map"]["isolation"]["exponent"] = exponent;
-    std::ofstream(copy / "manifest.json") << manifest.dump(2);
-    const fs::path out = out_ / ("detect_" + std::to_string(exponent));
-    const CommandResult detect = RunCommand(tod_ + " detect --model " + copy.string() + " --out " +
-                                            out.string() + " " + image);
+    const std::string name = "exponent_" + std::to_string(exponent);
+    const CommandResult detect = DetectForged(
+        paper, name,
+        [exponent](nlohmann::json& m) {
+          m["params"]["probability_map"]["isolation"]["exponent"] = exponent;
+        },
+        image);
     ASSERT_EQ(detect.exit_code, 0) << detect.output;
+    const fs::path out = out_ / ("detect_" + name);
     maps[exponent == 0 ? 0 : 1] = cv::imread((out / "2_prob.png").string(), cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(maps[exponent == 0 ? 0 : 1].empty());
   }
@@ -504,13 +519,9 @@ TEST_F(MasksCliTest, VerticalEdgeFeatureByDefaultPaperFeaturesOnRequest) {
 
   // The paper bundle's manifest made to claim the 21st feature: its 20-feature forests are
   // refused by name, not read shifted.
-  const fs::path forged = out_ / "forged";
-  fs::copy(paper, forged, fs::copy_options::recursive);
-  nlohmann::json manifest = Manifest(forged.string());
-  manifest["params"]["vertical_edge_feature"] = true;
-  std::ofstream(forged / "manifest.json") << manifest.dump(2);
-  const CommandResult refused = RunCommand(tod_ + " detect --model " + forged.string() + " --out " +
-                                           (out_ / "detect_forged").string() + " " + image);
+  const CommandResult refused = DetectForged(
+      paper, "forged", [](nlohmann::json& m) { m["params"]["vertical_edge_feature"] = true; },
+      image);
   EXPECT_NE(refused.exit_code, 0);
   EXPECT_NE(refused.output.find("must take 21 features"), std::string::npos) << refused.output;
 }
@@ -536,13 +547,9 @@ TEST_F(MasksCliTest, OrientationEntropyFeatureOnRequest) {
   std::ifstream json(out / "2.json");
   EXPECT_FALSE(nlohmann::json::parse(json)["proposals"].empty());
 
-  const fs::path forged = out_ / "forged_entropy";
-  fs::copy(model, forged, fs::copy_options::recursive);
-  nlohmann::json manifest = Manifest(forged.string());
-  manifest["params"]["orientation_entropy_feature"] = false;
-  std::ofstream(forged / "manifest.json") << manifest.dump(2);
-  const CommandResult refused = RunCommand(tod_ + " detect --model " + forged.string() + " --out " +
-                                           (out_ / "detect_forged_entropy").string() + " " + image);
+  const CommandResult refused = DetectForged(
+      model, "forged_entropy",
+      [](nlohmann::json& m) { m["params"]["orientation_entropy_feature"] = false; }, image);
   EXPECT_NE(refused.exit_code, 0);
   EXPECT_NE(refused.output.find("must take 21 features"), std::string::npos) << refused.output;
 }
