@@ -250,6 +250,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;
   report.map_superpixel_shares = bundle.params.probability_map.superpixel_shares;
   report.proposal_features = bundle.ordr.num_features();
+  report.proposal_feature_set = ProposalFeatureSet(bundle.params);
   report.free_space = road_labelled && not_obstacle
                           ? "mixed: the road label where the frame has one, else every non-void "
                             "non-obstacle pixel"
@@ -339,12 +340,8 @@ std::string FormatEvalTables(const EvalReport& r) {
     << (r.map_superpixel_shares ? ", each pixel by its superpixel's share of the box"
                                 : ", whole boxes")
     << "\n";
-  o << "regressors: " << r.proposal_features << " proposal features"
-    << (r.proposal_features == 21   ? " (the paper's 20 and the vertical edge share)"
-        : r.proposal_features == 22 ? " (the paper's 20, the vertical edge share and the "
-                                      "orientation entropy)"
-                                    : "")
-    << "\n";
+  o << "regressors: " << r.proposal_features << " proposal features (" << r.proposal_feature_set
+    << ")\n";
   {
     const ReportedObstacleCounts& a = r.reported;
     char text[256];

@@ -73,9 +73,10 @@ struct EvalReport {
   // variants' maps weigh each box by isolation^this; 0 is the paper's map as published.
   float map_isolation_exponent = 0.f;
   bool map_superpixel_shares = false;  // the paper's map weighs boxes by superpixel shares
-  // The regressors' row width: the paper's 20, or 21 with the vertical edge share
-  // (PipelineParams::vertical_edge_feature).
+  // The regressors' row width and which features they are (ProposalFeatureSet): the paper's 20,
+  // with the vertical edge share and the orientation entropy when the bundle has them.
   int proposal_features = 0;
+  std::string proposal_feature_set;
   int instances = 0;
   std::map<std::string, VariantCurves> proposals;   // proposal variants
   std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)

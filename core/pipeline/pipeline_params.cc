@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/features/box_features.h"
 #include "core/pipeline/json_integers.h"
 
 namespace tod {
@@ -84,7 +85,17 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
 }
 
 int ProposalFeatureCount(const PipelineParams& params) {
-  return 20 + (params.vertical_edge_feature ? 1 : 0) + (params.orientation_entropy_feature ? 1 : 0);
+  BoxFeatureOptions options;
+  options.vertical_edges = params.vertical_edge_feature;
+  options.orientation_entropy = params.orientation_entropy_feature;
+  return NumBoxFeatures(options);
+}
+
+std::string ProposalFeatureSet(const PipelineParams& params) {
+  std::string set = "the paper's 20";
+  if (params.vertical_edge_feature) set += ", the vertical edge share";
+  if (params.orientation_entropy_feature) set += ", the orientation entropy";
+  return set;
 }
 
 PipelineParams TrainingDefaultParams() {

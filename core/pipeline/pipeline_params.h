@@ -3,6 +3,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "core/base/status.h"
 #include "core/edges/edge_source.h"
@@ -98,8 +99,10 @@ struct PipelineParams {
   bool orientation_entropy_feature = false;
 };
 
-// The proposal features the regressors of a bundle with these parameters read: 20, 21 or 22.
+// The proposal features the regressors of a bundle with these parameters read: how many (20, 21
+// or 22; box_features.h's NumBoxFeatures) and which, in words.
 int ProposalFeatureCount(const PipelineParams& params);
+std::string ProposalFeatureSet(const PipelineParams& params);
 
 // The parameters `tod train` gives a new bundle: the defaults above, with the occlusion
 // classifier's early exit at {25 trees, 0.05}. A pair whose first 25 of 400 trees average at

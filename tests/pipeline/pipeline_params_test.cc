@@ -32,6 +32,27 @@ TEST(PipelineParams, JsonRoundTripAndMissingKeysKeepDefaults) {
   EXPECT_EQ(partial->superpixels.k, 1024);
 }
 
+// The regressors' row width and its words follow the two optional features, each on its own;
+// a manifest without the newer key keeps the older bundles' 20 or 21.
+TEST(PipelineParams, ProposalFeaturesFollowTheOptionalFeatures) {
+  PipelineParams p;
+  EXPECT_EQ(ProposalFeatureCount(p), 20);
+  EXPECT_EQ(ProposalFeatureSet(p), "the paper's 20");
+  p.vertical_edge_feature = true;
+  EXPECT_EQ(ProposalFeatureCount(p), 21);
+  p.orientation_entropy_feature = true;
+  EXPECT_EQ(ProposalFeatureCount(p), 22);
+  EXPECT_EQ(ProposalFeatureSet(p),
+            "the paper's 20, the vertical edge share, the orientation entropy");
+  p.vertical_edge_feature = false;
+  EXPECT_EQ(ProposalFeatureCount(p), 21);
+  EXPECT_EQ(ProposalFeatureSet(p), "the paper's 20, the orientation entropy");
+  const auto older = PipelineParamsFromJson({{"vertical_edge_feature", true}});
+  ASSERT_TRUE(older.ok());
+  EXPECT_FALSE(older->orientation_entropy_feature);
+  EXPECT_EQ(ProposalFeatureCount(*older), 21);
+}
+
 TEST(PipelineParams, WrongTypesAndRangesAreErrors) {
   EXPECT_FALSE(PipelineParamsFromJson({{"boxes", {{"alpha", "big"}}}}).ok());
   EXPECT_FALSE(PipelineParamsFromJson({{"boxes", {{"alpha", 1.5}}}}).ok());
