@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "core/pipeline/frame_budget.h"
+#include "core/pipeline/parallel.h"
 
 namespace tod {
 
@@ -34,10 +35,14 @@ Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes
                              &superpixels);
 }
 
+bool ObstaclesFromWholeBoxMap(const PipelineParams& params, MapKind kind) {
+  return kind == MapKind::kNormalized && params.probability_map.superpixel_shares;
+}
+
 Result<cv::Mat1f> ObstacleComponentsMap(const MapAccumulation& accumulated, cv::Size image_size,
                                         const PipelineParams& params, MapKind kind,
                                         const cv::Mat1f& served) {
-  if (kind != MapKind::kNormalized || !params.probability_map.superpixel_shares) return served;
+  if (!ObstaclesFromWholeBoxMap(params, kind)) return served;
   return PaintProbabilityMap(accumulated, image_size, /*superpixel_shares=*/false);
 }
 
@@ -126,16 +131,28 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   for (std::size_t i = 0; i < fused.size(); ++i)
     scored[i] = {regressed.proposals.boxes[i].box, fused[i]};
   const MapAccumulation accumulated = AccumulatedBoxes(scored, bundle_.params.probability_map);
-  Result<cv::Mat1f> probability = ServedProbabilityMap(scored, accumulated, bgr.size(), oaocc,
-                                                       bundle_.params, options.map_kind);
+  // The served map and the whole-box map of the obstacles (when they differ) are painted from the
+  // same boxes and read nothing of each other: side by side when the request has two threads.
+  Result<cv::Mat1f> probability = Status::Internal("map not painted");
+  Result<cv::Mat1f> whole_boxes = Status::Internal("map not painted");
+  const bool separate_components = ObstaclesFromWholeBoxMap(bundle_.params, options.map_kind);
+  const auto paint = [&](int which) {
+    if (which == 0)
+      probability = ServedProbabilityMap(scored, accumulated, bgr.size(), oaocc, bundle_.params,
+                                         options.map_kind);
+    else
+      whole_boxes = PaintProbabilityMap(accumulated, bgr.size(), /*superpixel_shares=*/false);
+    return Status::Ok();
+  };
+  for (const Status& s : ParallelFor(separate_components ? 2 : 1, threads, paint))
+    if (!s.ok()) return s;
   if (!probability.ok()) return probability.status();
   out.map_kind = options.map_kind;
   out.width = bgr.cols;
   out.height = bgr.rows;
-  const Result<cv::Mat1f> components = ObstacleComponentsMap(
-      accumulated, bgr.size(), bundle_.params, options.map_kind, *probability);
-  if (!components.ok()) return components.status();
-  out.obstacles = ScoreObstacles(*components, accumulated.boxes, bundle_.params, options);
+  if (separate_components && !whole_boxes.ok()) return whole_boxes.status();
+  const cv::Mat1f& components = separate_components ? *whole_boxes : *probability;
+  out.obstacles = ScoreObstacles(components, accumulated.boxes, bundle_.params, options);
   timer.Mark("probability_map");
 
   std::vector<std::size_t> order(fused.size());

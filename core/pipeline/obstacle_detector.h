@@ -27,11 +27,15 @@ Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes
                                        const OcclusionEdges& oaocc, const PipelineParams& params,
                                        MapKind kind);
 
-// The map whose components are a frame's obstacles: `served` itself, except that for the
-// normalised map with superpixel shares it is the same boxes painted whole. Shares tighten a
-// map's pixels around each object, but they split the boxes' area into more and smaller
-// components, on which the obstacles' calibration fits lower scores (README "Real frames",
-// point 19): the obstacle list, and the calibration, stay those of the whole-box map.
+// Whether a frame's obstacles come from a map of their own, the same boxes painted whole: for
+// the normalised map with superpixel shares. Shares tighten a map's pixels around each object,
+// but they split the boxes' area into more and smaller components, on which the obstacles'
+// calibration fits lower scores (README "Real frames", point 19): the obstacle list, and the
+// calibration, stay those of the whole-box map.
+bool ObstaclesFromWholeBoxMap(const PipelineParams& params, MapKind kind);
+
+// The map whose components are a frame's obstacles: the whole-box map when
+// ObstaclesFromWholeBoxMap, else `served` itself.
 Result<cv::Mat1f> ObstacleComponentsMap(const MapAccumulation& accumulated, cv::Size image_size,
                                         const PipelineParams& params, MapKind kind,
                                         const cv::Mat1f& served);
