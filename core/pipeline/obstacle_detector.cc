@@ -48,6 +48,34 @@ Result<cv::Mat1f> ObstacleComponentsMap(const MapAccumulation& accumulated, cv::
 
 namespace {
 
+// The map a detection serves and, when the obstacles come from a map of their own
+// (ObstaclesFromWholeBoxMap), that map (else `components` stays empty). The two are painted from
+// the same boxes and read nothing of each other: side by side when the request has two threads.
+struct FrameMaps {
+  cv::Mat1f served;
+  cv::Mat1f components;
+};
+Result<FrameMaps> PaintFrameMaps(const std::vector<ScoredBox>& fused_boxes,
+                                 const MapAccumulation& accumulated, cv::Size image_size,
+                                 const OcclusionEdges& oaocc, const PipelineParams& params,
+                                 MapKind kind, int threads) {
+  Result<cv::Mat1f> served = Status::Internal("map not painted");
+  Result<cv::Mat1f> whole_boxes = Status::Internal("map not painted");
+  const bool separate = ObstaclesFromWholeBoxMap(params, kind);
+  const auto paint = [&](int which) {
+    if (which == 0)
+      served = ServedProbabilityMap(fused_boxes, accumulated, image_size, oaocc, params, kind);
+    else
+      whole_boxes = PaintProbabilityMap(accumulated, image_size, /*superpixel_shares=*/false);
+    return Status::Ok();
+  };
+  for (const Status& s : ParallelFor(separate ? 2 : 1, threads, paint))
+    if (!s.ok()) return s;
+  if (!served.ok()) return served.status();
+  if (separate && !whole_boxes.ok()) return whole_boxes.status();
+  return FrameMaps{std::move(*served), separate ? std::move(*whole_boxes) : cv::Mat1f()};
+}
+
 // The manifest's training data: one root, or several joined by " + ".
 std::string TrainedOn(const nlohmann::json& training) {
   if (!training.is_object() || !training.contains("data")) return {};
@@ -131,27 +159,13 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   for (std::size_t i = 0; i < fused.size(); ++i)
     scored[i] = {regressed.proposals.boxes[i].box, fused[i]};
   const MapAccumulation accumulated = AccumulatedBoxes(scored, bundle_.params.probability_map);
-  // The served map and the whole-box map of the obstacles (when they differ) are painted from the
-  // same boxes and read nothing of each other: side by side when the request has two threads.
-  Result<cv::Mat1f> probability = Status::Internal("map not painted");
-  Result<cv::Mat1f> whole_boxes = Status::Internal("map not painted");
-  const bool separate_components = ObstaclesFromWholeBoxMap(bundle_.params, options.map_kind);
-  const auto paint = [&](int which) {
-    if (which == 0)
-      probability = ServedProbabilityMap(scored, accumulated, bgr.size(), oaocc, bundle_.params,
-                                         options.map_kind);
-    else
-      whole_boxes = PaintProbabilityMap(accumulated, bgr.size(), /*superpixel_shares=*/false);
-    return Status::Ok();
-  };
-  for (const Status& s : ParallelFor(separate_components ? 2 : 1, threads, paint))
-    if (!s.ok()) return s;
-  if (!probability.ok()) return probability.status();
+  Result<FrameMaps> maps = PaintFrameMaps(scored, accumulated, bgr.size(), oaocc, bundle_.params,
+                                          options.map_kind, threads);
+  if (!maps.ok()) return maps.status();
   out.map_kind = options.map_kind;
   out.width = bgr.cols;
   out.height = bgr.rows;
-  if (separate_components && !whole_boxes.ok()) return whole_boxes.status();
-  const cv::Mat1f& components = separate_components ? *whole_boxes : *probability;
+  const cv::Mat1f& components = maps->components.empty() ? maps->served : maps->components;
   out.obstacles = ScoreObstacles(components, accumulated.boxes, bundle_.params, options);
   timer.Mark("probability_map");
 
@@ -167,7 +181,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
     out.proposals.push_back(
         {regressed.proposals.boxes[i].box, fused[i], regressed.ordr[i], regressed.obdr[i]});
   }
-  if (options.want_probability_map) out.probability = std::move(*probability);
+  if (options.want_probability_map) out.probability = std::move(maps->served);
   if (superpixels != nullptr) *superpixels = {oaocc.superpixels, oaocc.r1};
   out.timings = timer.times();
   return out;
