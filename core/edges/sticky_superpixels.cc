@@ -1,6 +1,7 @@
 #include "core/edges/sticky_superpixels.h"
 
 #include <algorithm>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <utility>
@@ -11,16 +12,6 @@
 
 namespace tod {
 namespace {
-
-// RGB (any channel order: only distances matter) in [0,1], smoothed by the radius-1 triangle
-// filter [1 2 1]/4 in both directions, as one flat interleaved array.
-cv::Mat3f SmoothColour(const cv::Mat3f& colour) {
-  const cv::Mat1f kernel = (cv::Mat1f(1, 3) << 0.25f, 0.5f, 0.25f);
-  cv::Mat3f smoothed;
-  cv::sepFilter2D(colour, smoothed, CV_32F, kernel, kernel, cv::Point(-1, -1), 0.0,
-                  cv::BORDER_REFLECT);
-  return smoothed;
-}
 
 StickyImage ViewOf(const cv::Mat3f& colour, const cv::Mat1f& edge) {
   return StickyImage{colour.cols, colour.rows, colour.ptr<float>(0), edge.ptr<float>(0)};
@@ -34,6 +25,24 @@ std::vector<int> OneLabelPerPixel(int width, int height) {
 }
 
 }  // namespace
+
+// OpenCV runs this filter on one thread; bands of rows run on its pool instead. A band is a view
+// into the whole image, and OpenCV's filters read the rows beyond a view from its parent (the
+// border rule applies at the image's own edges only), so every band's pixels are those of one
+// call over the whole image.
+cv::Mat3f SmoothStickyColour(const cv::Mat3f& colour) {
+  const cv::Mat1f kernel = (cv::Mat1f(1, 3) << 0.25f, 0.5f, 0.25f);
+  cv::Mat3f smoothed(colour.size());
+  constexpr int kBandRows = 64;
+  const int bands = (colour.rows + kBandRows - 1) / kBandRows;
+  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+    const cv::Range rows(range.start * kBandRows, std::min(colour.rows, range.end * kBandRows));
+    cv::Mat band = smoothed.rowRange(rows);
+    cv::sepFilter2D(colour.rowRange(rows), band, CV_32F, kernel, kernel, cv::Point(-1, -1), 0.0,
+                    cv::BORDER_REFLECT);
+  });
+  return smoothed;
+}
 
 Status ValidateSuperpixelInput(const cv::Mat3b& bgr, const cv::Mat1f& edge,
                                const StickySuperpixelParams& params) {
@@ -84,7 +93,7 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
     cv::Mat1f edge_half;
     cv::resize(colour(even), colour_half, cv::Size(half_w, half_h), 0, 0, cv::INTER_AREA);
     cv::resize(edge_full(even), edge_half, cv::Size(half_w, half_h), 0, 0, cv::INTER_AREA);
-    const cv::Mat3f smooth_half = SmoothColour(colour_half);
+    const cv::Mat3f smooth_half = SmoothStickyColour(colour_half);
     StickyWeights half_weights = weights;
     half_weights.size *= 0.25;
     half_weights.position *= 4.0;
@@ -105,7 +114,7 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
     flat = OneLabelPerPixel(width, height);  // a 1-pixel-thin crop has no half resolution
   }
 
-  const cv::Mat3f smooth_full = SmoothColour(colour);
+  const cv::Mat3f smooth_full = SmoothStickyColour(colour);
   RefineStickyLabels(ViewOf(smooth_full, edge_full), weights, params.iterations, flat,
                      params.strip_rows);
 

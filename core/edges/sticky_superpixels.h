@@ -31,6 +31,11 @@ struct Superpixels {
 Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat1f& edge,
                                              const StickySuperpixelParams& params = {});
 
+// The colour the refinement compares: `colour` smoothed by the radius-1 triangle filter [1 2 1]/4
+// in both directions (borders reflected), computed in bands of rows on OpenCV's pool; the same
+// pixels as one cv::sepFilter2D call over the whole image (its reference; the test compares them).
+cv::Mat3f SmoothStickyColour(const cv::Mat3f& colour);
+
 // Non-empty image, edge map of the same size and finite, k > 0, alpha and beta in [0,1],
 // iterations >= 0, strip_rows >= 0.
 Status ValidateSuperpixelInput(const cv::Mat3b& bgr, const cv::Mat1f& edge,

@@ -1,6 +1,7 @@
 #include "core/edges/superpixel_boundaries.h"
 
 #include <algorithm>
+#include <opencv2/core/utility.hpp>
 #include <vector>
 
 namespace tod {
@@ -104,59 +105,64 @@ void InsertSuperpixelBoundaries(const cv::Mat1f& edge, cv::Mat1i& labels) {
   // Step 1: the stronger-edge pixel of every differing 4-adjacent pair (ties: the first pixel).
   // Pixel i is marked by the pair it forms with its left or upper neighbour j when
   // !(e[j] >= e[i]), and by the pair with its right or lower neighbour j when e[i] >= e[j].
+  // Steps 1 and 2 are each a pure function of a snapshot, row by row: on OpenCV's pool.
   std::vector<int> step1(n);
-  for (int y = 0; y < height; ++y) {
-    const size_t row = static_cast<size_t>(y) * width;
-    const int* const lr = l + row;
-    const float* const er = e + row;
-    // Rows outside the image are replaced by the row itself: a pixel never differs from itself.
-    const int* const lu = y > 0 ? lr - width : lr;
-    const float* const eu = y > 0 ? er - width : er;
-    const int* const ld = y + 1 < height ? lr + width : lr;
-    const float* const ed = y + 1 < height ? er + width : er;
-    int* const out = step1.data() + row;
-    const auto pixel = [&](int x, bool has_left, bool has_right) {
-      const int own = lr[x];
-      const float ei = er[x];
-      bool marked = ((lu[x] != own) & !(eu[x] >= ei)) | ((ld[x] != own) & (ei >= ed[x]));
-      if (has_left) marked |= (lr[x - 1] != own) & !(er[x - 1] >= ei);
-      if (has_right) marked |= (lr[x + 1] != own) & (ei >= er[x + 1]);
-      out[x] = marked ? 0 : own;
-    };
-    pixel(0, false, width > 1);
-    for (int x = 1; x + 1 < width; ++x) pixel(x, true, true);
-    if (width > 1) pixel(width - 1, true, false);
-  }
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const size_t row = static_cast<size_t>(y) * width;
+      const int* const lr = l + row;
+      const float* const er = e + row;
+      // Rows outside the image are replaced by the row itself: a pixel never differs from itself.
+      const int* const lu = y > 0 ? lr - width : lr;
+      const float* const eu = y > 0 ? er - width : er;
+      const int* const ld = y + 1 < height ? lr + width : lr;
+      const float* const ed = y + 1 < height ? er + width : er;
+      int* const out = step1.data() + row;
+      const auto pixel = [&](int x, bool has_left, bool has_right) {
+        const int own = lr[x];
+        const float ei = er[x];
+        bool marked = ((lu[x] != own) & !(eu[x] >= ei)) | ((ld[x] != own) & (ei >= ed[x]));
+        if (has_left) marked |= (lr[x - 1] != own) & !(er[x - 1] >= ei);
+        if (has_right) marked |= (lr[x + 1] != own) & (ei >= er[x + 1]);
+        out[x] = marked ? 0 : own;
+      };
+      pixel(0, false, width > 1);
+      for (int x = 1; x + 1 < width; ++x) pixel(x, true, true);
+      if (width > 1) pixel(width - 1, true, false);
+    }
+  });
 
   // Step 2: separate diagonal contacts, judged on the step-1 map (a snapshot, so the raster order
   // does not matter). Outside the image counts as the pixel's own label: a labelled pixel is
   // marked when some 8-neighbour carries another non-zero label and some 4-neighbour differs
   // from its own.
-  for (int y = 0; y < height; ++y) {
-    const size_t row = static_cast<size_t>(y) * width;
-    const int* const sr = step1.data() + row;
-    const int* const su = y > 0 ? sr - width : sr;  // outside: the row itself, as above
-    const int* const sd = y + 1 < height ? sr + width : sr;
-    int* const out = l + row;
-    const auto pixel = [&](int x, bool has_left, bool has_right) {
-      const int own = sr[x];
-      const auto other = [own](int t) { return (t != 0) & (t != own); };
-      bool open = (su[x] != own) | (sd[x] != own);  // a 4-neighbour differs from own
-      bool touches = other(su[x]) | other(sd[x]);   // an 8-neighbour: another non-zero label
-      if (has_left) {
-        open |= sr[x - 1] != own;
-        touches |= other(sr[x - 1]) | other(su[x - 1]) | other(sd[x - 1]);
-      }
-      if (has_right) {
-        open |= sr[x + 1] != own;
-        touches |= other(sr[x + 1]) | other(su[x + 1]) | other(sd[x + 1]);
-      }
-      out[x] = (open & touches) ? 0 : own;  // own == 0 stays 0 either way
-    };
-    pixel(0, false, width > 1);
-    for (int x = 1; x + 1 < width; ++x) pixel(x, true, true);
-    if (width > 1) pixel(width - 1, true, false);
-  }
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const size_t row = static_cast<size_t>(y) * width;
+      const int* const sr = step1.data() + row;
+      const int* const su = y > 0 ? sr - width : sr;  // outside: the row itself, as above
+      const int* const sd = y + 1 < height ? sr + width : sr;
+      int* const out = l + row;
+      const auto pixel = [&](int x, bool has_left, bool has_right) {
+        const int own = sr[x];
+        const auto other = [own](int t) { return (t != 0) & (t != own); };
+        bool open = (su[x] != own) | (sd[x] != own);  // a 4-neighbour differs from own
+        bool touches = other(su[x]) | other(sd[x]);   // an 8-neighbour: another non-zero label
+        if (has_left) {
+          open |= sr[x - 1] != own;
+          touches |= other(sr[x - 1]) | other(su[x - 1]) | other(sd[x - 1]);
+        }
+        if (has_right) {
+          open |= sr[x + 1] != own;
+          touches |= other(sr[x + 1]) | other(su[x + 1]) | other(sd[x + 1]);
+        }
+        out[x] = (open & touches) ? 0 : own;  // own == 0 stays 0 either way
+      };
+      pixel(0, false, width > 1);
+      for (int x = 1; x + 1 < width; ++x) pixel(x, true, true);
+      if (width > 1) pixel(width - 1, true, false);
+    }
+  });
 
   // Step 3: thinning, in place so that two halves of a thick boundary cannot both be returned to
   // their different sides. Whether the labelled 8-neighbours share one label does not depend on

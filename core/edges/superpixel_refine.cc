@@ -33,6 +33,15 @@ struct alignas(64) LabelSums {
     c1 += sign * c[1];
     c2 += sign * c[2];
   }
+  // Add(1.0, ...) without updating inverse_count (set it once the pixels are in).
+  void Accumulate(int px, int py, const float* c) {
+    count += 1.0;
+    x += px;
+    y += py;
+    c0 += c[0];
+    c1 += c[1];
+    c2 += c[2];
+  }
 };
 static_assert(sizeof(LabelSums) == 64);
 
@@ -401,12 +410,15 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
   for (size_t id = 0; id < original_id.size(); ++id) original_id[id] = static_cast<int>(id);
   RenumberDensely(labels, sums, original_id);
   sums.resize(original_id.size());
+  // The sums as Add would leave them, with the one division per label done once at the end (the
+  // same value: 1 / count of the final count) instead of once per pixel.
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const size_t i = static_cast<size_t>(y) * width + x;
-      sums[labels[i]].Add(1.0, x, y, image.colour + 3 * i);
+      sums[labels[i]].Accumulate(x, y, image.colour + 3 * i);
     }
   }
+  for (LabelSums& s : sums) s.inverse_count = s.count > 0 ? 1.0 / s.count : 0.0;
 
   // Strips only pay off when there are several of them.
   const bool in_strips = strip_rows > 0 && height > 2 * strip_rows;

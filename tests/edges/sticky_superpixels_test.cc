@@ -382,5 +382,24 @@ TEST(SuperpixelBoundariesTest, RelabelSplitsDisconnectedPieces) {
   EXPECT_EQ(cv::countNonZero(sparse != (cv::Mat1i(1, 4) << 1, 0, 2, 1)), 0) << sparse;
 }
 
+// The colour smoothing runs in bands of rows; its reference is one cv::sepFilter2D call over the
+// whole image. A height that is no multiple of the band, and a band's worth of rows or fewer.
+TEST(SmoothStickyColour, BandsGiveThePixelsOfOneFilterCall) {
+  const cv::Mat1f kernel = (cv::Mat1f(1, 3) << 0.25f, 0.5f, 0.25f);
+  for (const int rows : {1, 2, 63, 64, 65, 331}) {
+    cv::Mat3f colour(rows, 97);
+    cv::randu(colour, 0.f, 1.f);
+    cv::Mat3f reference;
+    cv::sepFilter2D(colour, reference, CV_32F, kernel, kernel, cv::Point(-1, -1), 0.0,
+                    cv::BORDER_REFLECT);
+    for (const int threads : {1, 3}) {
+      cv::setNumThreads(threads);
+      const cv::Mat3f banded = SmoothStickyColour(colour);
+      EXPECT_EQ(cv::norm(banded, reference, cv::NORM_INF), 0.0) << rows << " rows";
+    }
+  }
+  cv::setNumThreads(-1);
+}
+
 }  // namespace
 }  // namespace tod
