@@ -137,7 +137,8 @@ Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
                          : all;
     windows_scored += (filter ? stats : unfiltered_stats).windows_visited;
   }
-  ProposalSet merged = MergeRegionBoxes(filtered, bundle.params.region_merge_iou);
+  ProposalSet merged =
+      MergeRegionBoxes(filtered, bundle.params.region_merge_iou, bundle.params.boxes.beta);
   std::vector<Box> by_objectness;
   for (const ScoredBox& b : merged.boxes) by_objectness.push_back(b.box);
   const RegressedProposals reg =

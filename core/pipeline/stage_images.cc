@@ -203,7 +203,8 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
   }
   // After the cross-region merge, as the detector regresses them.
   counts["proposals_total"] =
-      MergeRegionBoxes(per_region, bundle.params.region_merge_iou).boxes.size();
+      MergeRegionBoxes(per_region, bundle.params.region_merge_iou, bundle.params.boxes.beta)
+          .boxes.size();
   return out;
 }
 
