@@ -2,10 +2,13 @@
 
 #include <libdeflate.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <opencv2/core/utility.hpp>
 #include <string>
 #include <vector>
 
@@ -155,34 +158,39 @@ int PaethPredictor(int left, int up, int up_left) {
   return to_corner < nearer_distance ? up_left : nearer;
 }
 
-// Undoes one row's filter in place (PNG spec 9.2). `previous` is the row above, already
-// unfiltered (zeros for the first row); C bytes a pixel. The byte arithmetic is modulo 256.
+// Undoes one row's filter in place (PNG spec 9.2) on bytes [begin, end) of the row; `begin` is a
+// whole number of pixels, and bytes before it are already unfiltered. `previous` is the row above,
+// already unfiltered (zeros for the first row); C bytes a pixel. The byte arithmetic is modulo 256.
 template <int C>
-bool UnfilterRow(unsigned char filter, unsigned char* row, const unsigned char* previous,
-                 std::size_t length) {
+void UnfilterSpan(unsigned char filter, unsigned char* row, const unsigned char* previous,
+                  std::size_t begin, std::size_t end) {
   switch (filter) {
     case 0:
-      return true;
+      return;
     case 1:
-      for (std::size_t i = C; i < length; ++i)
+      for (std::size_t i = std::max<std::size_t>(begin, C); i < end; ++i)
         row[i] = static_cast<unsigned char>(row[i] + row[i - C]);
-      return true;
+      return;
     case 2:
-      for (std::size_t i = 0; i < length; ++i)
+      for (std::size_t i = begin; i < end; ++i)
         row[i] = static_cast<unsigned char>(row[i] + previous[i]);
-      return true;
+      return;
     case 3:
-      for (std::size_t i = 0; i < C; ++i)
+      for (std::size_t i = begin; i < std::min<std::size_t>(end, C); ++i)
         row[i] = static_cast<unsigned char>(row[i] + (previous[i] >> 1));
-      for (std::size_t i = C; i < length; ++i) {
+      for (std::size_t i = std::max<std::size_t>(begin, C); i < end; ++i) {
         row[i] = static_cast<unsigned char>(row[i] + ((row[i - C] + previous[i]) >> 1));
       }
-      return true;
+      return;
     case 4: {
       // The left and upper-left bytes of each channel stay in registers: read back from memory,
       // every byte waited for the store of the one before (the row is one dependency chain).
       int left[C] = {}, up_left[C] = {};
-      for (std::size_t i = 0; i < length; i += C) {
+      if (begin >= C) {
+        for (int k = 0; k < C; ++k)
+          left[k] = row[begin - C + k], up_left[k] = previous[begin - C + k];
+      }
+      for (std::size_t i = begin; i < end; i += C) {
         for (int k = 0; k < C; ++k) {
           const int up = previous[i + k];
           left[k] =
@@ -191,28 +199,79 @@ bool UnfilterRow(unsigned char filter, unsigned char* row, const unsigned char* 
           up_left[k] = up;
         }
       }
-      return true;
+      return;
     }
     default:
-      return false;
+      return;  // filter types were checked before any row (UnfilterToBgr)
   }
 }
 
-// Unfilters every row of `raw` in place and writes its pixels, reordered to BGR, into `image`.
+// Pixels [first, last) of one unfiltered row (after its filter byte), reordered to BGR.
 template <int C>
-Status UnfilterToBgr(FilteredRows& raw, cv::Mat3b& image) {
+void CopyToBgr(const unsigned char* pixels, int first, int last, cv::Vec3b* out) {
+  for (int x = first; x < last; ++x) {
+    const unsigned char* pixel = pixels + static_cast<std::size_t>(x) * C;
+    out[x] = cv::Vec3b(pixel[2], pixel[1], pixel[0]);
+  }
+}
+
+// Columns [first, last) of every row: unfiltered in place and written into `image`, top to
+// bottom. When first > 0, the columns left of `first` of row y must be final before row y is
+// done here: `left_rows` (if any) counts the rows whose left part is final, and is waited on.
+// `done_rows` (if any) is raised after each row.
+template <int C>
+void UnfilterColumns(FilteredRows& raw, cv::Mat3b& image, int first, int last,
+                     const std::atomic<int>* left_rows, std::atomic<int>* done_rows) {
   const std::size_t length = static_cast<std::size_t>(image.cols) * C;
   const std::vector<unsigned char> zeros(length, 0);
   const unsigned char* previous = zeros.data();
   for (int y = 0; y < image.rows; ++y) {
+    if (left_rows != nullptr) {
+      for (int ready = left_rows->load(std::memory_order_acquire); ready <= y;
+           ready = left_rows->load(std::memory_order_acquire))
+        left_rows->wait(ready, std::memory_order_acquire);
+    }
     unsigned char* row = raw.bytes.get() + static_cast<std::size_t>(y) * (length + 1);
-    if (!UnfilterRow<C>(row[0], row + 1, previous, length)) return Corrupt("bad filter type");
-    const unsigned char* pixel = row + 1;
-    cv::Vec3b* out = image[y];
-    for (int x = 0; x < image.cols; ++x, pixel += C)
-      out[x] = cv::Vec3b(pixel[2], pixel[1], pixel[0]);
+    UnfilterSpan<C>(row[0], row + 1, previous, static_cast<std::size_t>(first) * C,
+                    static_cast<std::size_t>(last) * C);
+    CopyToBgr<C>(row + 1, first, last, image[y]);
     previous = row + 1;
+    if (done_rows != nullptr) {
+      done_rows->store(y + 1, std::memory_order_release);
+      done_rows->notify_one();
+    }
   }
+}
+
+// Unfilters every row of `raw` in place and writes its pixels, reordered to BGR, into `image`.
+// With two threads or more (OpenCV's pool, the request's threads) the rows are cut into a left
+// and a right half, each on a thread: a row's right half needs its left half (the left neighbour
+// of its first pixel) and the row above, its left half only the row above, so the right half
+// follows the left one row behind. One thread unfilters whole rows (the reference); the bytes are
+// the same either way.
+template <int C>
+Status UnfilterToBgr(FilteredRows& raw, cv::Mat3b& image) {
+  const std::size_t stride = static_cast<std::size_t>(image.cols) * C + 1;
+  for (int y = 0; y < image.rows; ++y)
+    if (raw.bytes[static_cast<std::size_t>(y) * stride] > 4) return Corrupt("bad filter type");
+  constexpr int kMinSplitColumns = 256;
+  if (cv::getNumThreads() < 2 || image.cols < kMinSplitColumns) {
+    UnfilterColumns<C>(raw, image, 0, image.cols, nullptr, nullptr);
+    return Status::Ok();
+  }
+  const int middle = image.cols / 2;
+  std::atomic<int> left_rows{0};
+  std::atomic<int> started{0};
+  // A task takes its half when it starts, so the left half belongs to the task that started
+  // first: the right half never waits for a task that has not begun, however the pool runs them.
+  cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& range) {
+    for (int n = range.start; n < range.end; ++n) {
+      if (started.fetch_add(1) == 0)
+        UnfilterColumns<C>(raw, image, 0, middle, nullptr, &left_rows);
+      else
+        UnfilterColumns<C>(raw, image, middle, image.cols, &left_rows, nullptr);
+    }
+  });
   return Status::Ok();
 }
 
