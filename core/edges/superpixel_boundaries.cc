@@ -87,6 +87,66 @@ int RelabelConnectedComponents(cv::Mat1i& labels) {
   return count;
 }
 
+namespace {
+
+// Step 1 of InsertSuperpixelBoundaries on row y: `out` (the row of the step-1 map) gets 0 where
+// the pixel is the stronger-edge pixel of a differing 4-adjacent pair (ties: the first pixel),
+// else its label. Pixel i is marked by the pair it forms with its left or upper neighbour j when
+// !(e[j] >= e[i]), and by the pair with its right or lower neighbour j when e[i] >= e[j]. (A
+// function of plain values: inside a lambda, the row loop read the width through a reference that
+// the stores to `out` might alias, and did not vectorise.)
+void MarkStrongerEdgeRow(const int* l, const float* e, int width, int height, int y, int* out) {
+  const size_t row = static_cast<size_t>(y) * width;
+  const int* const lr = l + row;
+  const float* const er = e + row;
+  // Rows outside the image are replaced by the row itself: a pixel never differs from itself.
+  const int* const lu = y > 0 ? lr - width : lr;
+  const float* const eu = y > 0 ? er - width : er;
+  const int* const ld = y + 1 < height ? lr + width : lr;
+  const float* const ed = y + 1 < height ? er + width : er;
+  const auto pixel = [&](int x, bool has_left, bool has_right) {
+    const int own = lr[x];
+    const float ei = er[x];
+    bool marked = ((lu[x] != own) & !(eu[x] >= ei)) | ((ld[x] != own) & (ei >= ed[x]));
+    if (has_left) marked |= (lr[x - 1] != own) & !(er[x - 1] >= ei);
+    if (has_right) marked |= (lr[x + 1] != own) & (ei >= er[x + 1]);
+    out[x] = marked ? 0 : own;
+  };
+  pixel(0, false, width > 1);
+  for (int x = 1; x + 1 < width; ++x) pixel(x, true, true);
+  if (width > 1) pixel(width - 1, true, false);
+}
+
+// Step 2 on row y of the step-1 map `marks`: a labelled pixel is marked (0 in `out`) when some
+// 8-neighbour carries another non-zero label and some 4-neighbour differs from its own. Outside
+// the image counts as the pixel's own label.
+void SeparateDiagonalRow(const int* marks, int width, int height, int y, int* out) {
+  const size_t row = static_cast<size_t>(y) * width;
+  const int* const sr = marks + row;
+  const int* const su = y > 0 ? sr - width : sr;  // outside: the row itself, as above
+  const int* const sd = y + 1 < height ? sr + width : sr;
+  const auto pixel = [&](int x, bool has_left, bool has_right) {
+    const int own = sr[x];
+    const auto other = [own](int t) { return (t != 0) & (t != own); };
+    bool open = (su[x] != own) | (sd[x] != own);  // a 4-neighbour differs from own
+    bool touches = other(su[x]) | other(sd[x]);   // an 8-neighbour: another non-zero label
+    if (has_left) {
+      open |= sr[x - 1] != own;
+      touches |= other(sr[x - 1]) | other(su[x - 1]) | other(sd[x - 1]);
+    }
+    if (has_right) {
+      open |= sr[x + 1] != own;
+      touches |= other(sr[x + 1]) | other(su[x + 1]) | other(sd[x + 1]);
+    }
+    out[x] = (open & touches) ? 0 : own;  // own == 0 stays 0 either way
+  };
+  pixel(0, false, width > 1);
+  for (int x = 1; x + 1 < width; ++x) pixel(x, true, true);
+  if (width > 1) pixel(width - 1, true, false);
+}
+
+}  // namespace
+
 void InsertSuperpixelBoundaries(const cv::Mat1f& edge, cv::Mat1i& labels) {
   const int width = labels.cols;
   const int height = labels.rows;
@@ -100,68 +160,19 @@ void InsertSuperpixelBoundaries(const cv::Mat1f& edge, cv::Mat1i& labels) {
   // Steps 1 and 2 are written per pixel, as "is this pixel marked?" computed from its
   // neighbourhood in the previous map, into a second map: no branch on the labels (whether two
   // labels differ is unpredictable along the many short borders), no read-modify-write of marks.
-  // Missing neighbours (outside the image) take no part, as in the pairwise definitions.
-
-  // Step 1: the stronger-edge pixel of every differing 4-adjacent pair (ties: the first pixel).
-  // Pixel i is marked by the pair it forms with its left or upper neighbour j when
-  // !(e[j] >= e[i]), and by the pair with its right or lower neighbour j when e[i] >= e[j].
-  // Steps 1 and 2 are each a pure function of a snapshot, row by row: on OpenCV's pool.
+  // Missing neighbours (outside the image) take no part, as in the pairwise definitions. Each
+  // step is a pure function of a snapshot, row by row, so its rows run on OpenCV's pool.
   std::vector<int> step1(n);
+  int* const marks = step1.data();
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y) {
-      const size_t row = static_cast<size_t>(y) * width;
-      const int* const lr = l + row;
-      const float* const er = e + row;
-      // Rows outside the image are replaced by the row itself: a pixel never differs from itself.
-      const int* const lu = y > 0 ? lr - width : lr;
-      const float* const eu = y > 0 ? er - width : er;
-      const int* const ld = y + 1 < height ? lr + width : lr;
-      const float* const ed = y + 1 < height ? er + width : er;
-      int* const out = step1.data() + row;
-      const auto pixel = [&](int x, bool has_left, bool has_right) {
-        const int own = lr[x];
-        const float ei = er[x];
-        bool marked = ((lu[x] != own) & !(eu[x] >= ei)) | ((ld[x] != own) & (ei >= ed[x]));
-        if (has_left) marked |= (lr[x - 1] != own) & !(er[x - 1] >= ei);
-        if (has_right) marked |= (lr[x + 1] != own) & (ei >= er[x + 1]);
-        out[x] = marked ? 0 : own;
-      };
-      pixel(0, false, width > 1);
-      for (int x = 1; x + 1 < width; ++x) pixel(x, true, true);
-      if (width > 1) pixel(width - 1, true, false);
-    }
+    for (int y = rows.start; y < rows.end; ++y)
+      MarkStrongerEdgeRow(l, e, width, height, y, marks + static_cast<size_t>(y) * width);
   });
-
   // Step 2: separate diagonal contacts, judged on the step-1 map (a snapshot, so the raster order
-  // does not matter). Outside the image counts as the pixel's own label: a labelled pixel is
-  // marked when some 8-neighbour carries another non-zero label and some 4-neighbour differs
-  // from its own.
+  // does not matter).
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y) {
-      const size_t row = static_cast<size_t>(y) * width;
-      const int* const sr = step1.data() + row;
-      const int* const su = y > 0 ? sr - width : sr;  // outside: the row itself, as above
-      const int* const sd = y + 1 < height ? sr + width : sr;
-      int* const out = l + row;
-      const auto pixel = [&](int x, bool has_left, bool has_right) {
-        const int own = sr[x];
-        const auto other = [own](int t) { return (t != 0) & (t != own); };
-        bool open = (su[x] != own) | (sd[x] != own);  // a 4-neighbour differs from own
-        bool touches = other(su[x]) | other(sd[x]);   // an 8-neighbour: another non-zero label
-        if (has_left) {
-          open |= sr[x - 1] != own;
-          touches |= other(sr[x - 1]) | other(su[x - 1]) | other(sd[x - 1]);
-        }
-        if (has_right) {
-          open |= sr[x + 1] != own;
-          touches |= other(sr[x + 1]) | other(su[x + 1]) | other(sd[x + 1]);
-        }
-        out[x] = (open & touches) ? 0 : own;  // own == 0 stays 0 either way
-      };
-      pixel(0, false, width > 1);
-      for (int x = 1; x + 1 < width; ++x) pixel(x, true, true);
-      if (width > 1) pixel(width - 1, true, false);
-    }
+    for (int y = rows.start; y < rows.end; ++y)
+      SeparateDiagonalRow(marks, width, height, y, l + static_cast<size_t>(y) * width);
   });
 
   // Step 3: thinning, in place so that two halves of a thick boundary cannot both be returned to
