@@ -67,6 +67,11 @@ Runner AddTrainCommand(CLI::App& app) {
   cmd->add_option("--hard-fraction", args->train.selection.hard_fraction,
                   "share of the regressors' negatives drawn as hard ones (tau_l; paper: 0.2)")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--paste-obstacles", args->train.pasted_copies,
+                  "regressors: also learn from N copies of every training frame with obstacles "
+                  "of other frames of its fold pasted in at their own rows, shifted sideways "
+                  "(0 = the frames as they are)")
+      ->check(CLI::Range(0, 8));
   cmd->add_option("--negative-bags", args->train.selection.negative_bags,
                   "regressors: draw the negatives N times (disjoint draws of the paper's counts) "
                   "and fit each regressor as N forests of trees/N, each on every positive and "

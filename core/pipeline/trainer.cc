@@ -100,6 +100,7 @@ struct Survey {
   std::vector<Box> obstacle_boxes;
   std::vector<int> usable;  // positions of the frames every later step visits
   std::vector<SkippedFrame> skipped;
+  std::vector<ObstacleCutout> cutouts;  // of the usable frames, with TrainOptions::pasted_copies
 };
 
 Result<Survey> SurveyFrames(TrainingRun& run) {
@@ -109,10 +110,16 @@ Result<Survey> SurveyFrames(TrainingRun& run) {
   for (int i = 0; i < n; ++i) all[i] = i;
   std::vector<cv::Size> sizes(n);
   std::vector<std::vector<ObstacleFootprint>> per_frame(n);
+  std::vector<std::vector<ObstacleCutout>> cutouts(n);
+  const bool cut_out = run.options().pasted_copies > 0;
   const std::vector<Status> statuses = run.ForEachFrame(all, [&](int i, const Sample& s) {
     sizes[i] = s.image.size();
-    for (const ObstacleInstance& inst : s.instances)
+    for (const ObstacleInstance& inst : s.instances) {
       per_frame[i].push_back({inst.box, inst.pixel_count()});
+      if (!cut_out) continue;
+      ObstacleCutout cutout = CutOutObstacle(s, inst, i, run.options().paste);
+      if (!cutout.patch.empty()) cutouts[i].push_back(std::move(cutout));
+    }
     return Status::Ok();
   });
   Survey survey;
@@ -137,10 +144,14 @@ Result<Survey> SurveyFrames(TrainingRun& run) {
       survey.footprints.push_back(f);
       survey.obstacle_boxes.push_back(f.box);
     }
+    for (ObstacleCutout& c : cutouts[i]) survey.cutouts.push_back(std::move(c));
   }
   if (survey.usable.empty()) return Status::InvalidArgument("no usable training frame");
   run.Say(std::to_string(survey.footprints.size()) + " training obstacles in " +
           std::to_string(survey.usable.size()) + " frames");
+  if (cut_out)
+    run.Say(std::to_string(survey.cutouts.size()) +
+            " of them cut out to paste (the others have void or another obstacle in their ring)");
   return survey;
 }
 
@@ -491,9 +502,81 @@ struct RegressorSamples {
   long long proposals = 0;
 };
 
+// The regressors' rows of one frame, real or with pasted obstacles.
+struct FrameRows {
+  cv::Mat1f ordr, obdr;
+  std::vector<float> ordr_targets, obdr_targets;
+  std::vector<int> ordr_bags, obdr_bags;
+  long long proposals = 0;
+
+  int positives = 0;  // the first rows of both regressors are the shared positives
+
+  // Appends the positives of `more` (a pasted copy: its negatives would be the frame's road
+  // again, and its proposals are not counted).
+  void AppendPositives(const FrameRows& more) {
+    const int p = more.positives;
+    if (p == 0) return;
+    ordr.push_back(more.ordr.rowRange(0, p));
+    obdr.push_back(more.obdr.rowRange(0, p));
+    ordr_targets.insert(ordr_targets.end(), more.ordr_targets.begin(),
+                        more.ordr_targets.begin() + p);
+    obdr_targets.insert(obdr_targets.end(), more.obdr_targets.begin(),
+                        more.obdr_targets.begin() + p);
+    ordr_bags.insert(ordr_bags.end(), more.ordr_bags.begin(), more.ordr_bags.begin() + p);
+    obdr_bags.insert(obdr_bags.end(), more.obdr_bags.begin(), more.obdr_bags.begin() + p);
+  }
+};
+
+// §6 on one frame: its proposals (maps by `upstream`'s classifiers), ranked by objectness or, with
+// `miner`, by the miner's fused score; the selected samples' features and targets.
+Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundle,
+                                       const ModelBundle& upstream, const ModelBundle* miner,
+                                       const SampleSelectionParams& selection, std::uint64_t seed) {
+  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
+      s.image, bundle.regions, *upstream.edges, &upstream.occlusion,
+      OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), upstream.params, true);
+  if (!computed.ok()) return computed.status();
+  const OcclusionEdges& oaocc = *computed;
+  const ProposalSet all = ProposeBoxes(
+      oaocc, bundle.regions, bundle.params.boxes,
+      DetectorProposalOptions(bundle.params, bundle.regions.num_layers()), bundle.size_filter);
+  std::vector<ScoredBox> ranked = all.boxes;  // scored by objectness
+  if (miner != nullptr) {
+    const RegressedProposals scored = RegressProposals(*miner, s.image, oaocc, bundle.regions, all);
+    const std::vector<float> fused = FuseScores(scored.ordr, scored.obdr, bundle.params.fusion);
+    for (std::size_t j = 0; j < ranked.size(); ++j) ranked[j].score = fused[j];
+  }
+  auto selected = SelectTrainingSamples(ranked, s, bundle.regions.RangeLimits(), selection, seed);
+  if (!selected.ok()) return selected.status();
+  const BoxFeatureOptions features = FeatureOptionsForFrame(bundle, s.image.cols, s.image.rows);
+  FrameRows rows;
+  rows.ordr = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
+                                      Subset(all, selected->ordr_indices), features);
+  rows.obdr = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
+                                      Subset(all, selected->obdr_indices), features);
+  rows.ordr_targets = std::move(selected->ordr_targets);
+  rows.obdr_targets = std::move(selected->obdr_targets);
+  rows.ordr_bags = std::move(selected->ordr_bags);
+  rows.obdr_bags = std::move(selected->obdr_bags);
+  rows.proposals = static_cast<long long>(all.boxes.size());
+  rows.positives = static_cast<int>(selected->positive_indices.size());
+  return rows;
+}
+
+// The cut-outs frame `i` may be pasted with: those of the other frames of its fold, so that no
+// part trained on the other fold (out-of-fold maps, the calibration's regressors) sees them.
+std::vector<const ObstacleCutout*> DonorsFor(int i, const Survey& survey,
+                                             const ClassifierFolds& folds) {
+  std::vector<const ObstacleCutout*> donors;
+  for (const ObstacleCutout& c : survey.cutouts)
+    if (c.frame != i && folds.FoldOf(c.frame) == folds.FoldOf(i)) donors.push_back(&c);
+  return donors;
+}
+
 // With `miner` (a bundle with trained regressors), the negatives' "hard" share is drawn from the
 // proposals the miner's fused score puts above selection.hard_objectness instead of by
-// objectness (TrainOptions::mine_hard_negatives).
+// objectness (TrainOptions::mine_hard_negatives). With TrainOptions::pasted_copies, each frame's
+// rows are followed by those of its copies with pasted obstacles.
 Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey& survey,
                                                  const ModelBundle& bundle,
                                                  const ClassifierFolds& folds,
@@ -506,45 +589,34 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
   out.ordr_bags.resize(n), out.obdr_bags.resize(n);
   out.num_bags = options.selection.negative_bags;
   std::vector<long long> proposals(n, 0);
-  const std::vector<int> limits = bundle.regions.RangeLimits();
   std::atomic<int> done{0};
   const Status st =
       run.FirstError(survey.usable, run.ForEachFrame(survey.usable, [&](int i, const Sample& s) {
         if (cv::countNonZero(s.road) > 0) {
           const ModelBundle& upstream = folds.For(bundle, i);
-          const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-              s.image, bundle.regions, *upstream.edges, &upstream.occlusion,
-              OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), upstream.params,
-              true);
-          if (!computed.ok()) return computed.status();
-          const OcclusionEdges& oaocc = *computed;
-          const ProposalSet all =
-              ProposeBoxes(oaocc, bundle.regions, bundle.params.boxes,
-                           DetectorProposalOptions(bundle.params, bundle.regions.num_layers()),
-                           bundle.size_filter);
-          proposals[i] = static_cast<long long>(all.boxes.size());
-          std::vector<ScoredBox> ranked = all.boxes;  // scored by objectness
-          if (miner != nullptr) {
-            const RegressedProposals scored =
-                RegressProposals(*miner, s.image, oaocc, bundle.regions, all);
-            const std::vector<float> fused =
-                FuseScores(scored.ordr, scored.obdr, bundle.params.fusion);
-            for (std::size_t j = 0; j < ranked.size(); ++j) ranked[j].score = fused[j];
+          const std::uint64_t seed = options.seed * 1000003ULL + static_cast<unsigned>(i);
+          auto rows = RegressorRowsOfFrame(s, bundle, upstream, miner, options.selection, seed);
+          if (!rows.ok()) return rows.status();
+          const std::vector<const ObstacleCutout*> donors =
+              options.pasted_copies > 0 ? DonorsFor(i, survey, folds)
+                                        : std::vector<const ObstacleCutout*>{};
+          for (int copy = 1; copy <= options.pasted_copies && !donors.empty(); ++copy) {
+            const std::uint64_t copy_seed = seed + 0x9E3779B97F4A7C15ULL * copy;
+            Sample pasted = PasteObstacles(s, donors, copy_seed, options.paste);
+            if (pasted.instances.size() == s.instances.size()) continue;  // no place was free
+            VoidOwnObstacles(pasted, s.instances.size());
+            auto more =
+                RegressorRowsOfFrame(pasted, bundle, upstream, miner, options.selection, copy_seed);
+            if (!more.ok()) return more.status().WithContext("pasted copy " + std::to_string(copy));
+            rows->AppendPositives(*more);
           }
-          auto selected =
-              SelectTrainingSamples(ranked, s, limits, options.selection,
-                                    options.seed * 1000003ULL + static_cast<unsigned>(i));
-          if (!selected.ok()) return selected.status();
-          const BoxFeatureOptions features =
-              FeatureOptionsForFrame(bundle, s.image.cols, s.image.rows);
-          out.ordr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
-                                                     Subset(all, selected->ordr_indices), features);
-          out.obdr_rows[i] = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
-                                                     Subset(all, selected->obdr_indices), features);
-          out.ordr_targets[i] = selected->ordr_targets;
-          out.obdr_targets[i] = selected->obdr_targets;
-          out.ordr_bags[i] = selected->ordr_bags;
-          out.obdr_bags[i] = selected->obdr_bags;
+          proposals[i] = rows->proposals;
+          out.ordr_rows[i] = std::move(rows->ordr);
+          out.obdr_rows[i] = std::move(rows->obdr);
+          out.ordr_targets[i] = std::move(rows->ordr_targets);
+          out.obdr_targets[i] = std::move(rows->obdr_targets);
+          out.ordr_bags[i] = std::move(rows->ordr_bags);
+          out.obdr_bags[i] = std::move(rows->obdr_bags);
         }
         const int finished = ++done;
         if (finished % 10 == 0 || finished == static_cast<int>(survey.usable.size()))
@@ -815,6 +887,7 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
                                                             : options.selection.obdr_negatives},
         {"negative_bags", options.selection.negative_bags},
         {"hard_fraction", options.selection.hard_fraction},
+        {"pasted_copies", options.pasted_copies},
         {"features", bundle.ordr.num_features()},
         {"maps", folds.enabled ? "out_of_fold" : "in_sample"},
         {"fold_layout", FoldLayoutName(options.fold_layout)}};

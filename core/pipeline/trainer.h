@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/data/pasted_obstacles.h"
 #include "core/edges/edge_source.h"
 #include "core/edges/occlusion_classifier.h"
 #include "core/features/sample_selection.h"
@@ -63,6 +64,12 @@ struct TrainOptions {
   // (fused score) instead of by objectness, and train again. false: one round, hard negatives
   // by objectness (the paper's training).
   bool mine_hard_negatives = true;
+  // Pasted obstacles (not in the paper; pasted_obstacles.h, README "Real frames"): the regressors
+  // also learn from this many copies of every training frame with obstacles of other frames of
+  // its fold pasted in (0 = the frames as they are). Only the regressors' samples: the edge and
+  // occlusion classifiers, the calibration and the map's fit see the real frames alone.
+  int pasted_copies = 0;
+  PasteParams paste;
   // Stacked training (not in the paper; README "Real frames"): the maps a learned part trains on
   // (edge maps for the occlusion classifier; edge and occlusion maps for the regressors and the
   // score calibration) come from classifiers trained on the other of two folds of frames, so
