@@ -125,8 +125,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     for (int k = 0; k < layers; ++k)
       ms_regions.push_back(
           ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k, true, filter));
-    ProposalSet bp =
-        MergeRegionBoxes(ms_regions, bundle.params.region_merge_iou, bundle.params.boxes.beta);
+    ProposalSet bp = MergeRegionBoxes(ms_regions, bundle.params.region_merge_iou);
     timer.Mark("proposals");
     // R1's stride factor is 1 with and without MS, so its boxes serve OAOCC+OLP@1 and OP too;
     // only R2..RK are scored again without MS.
@@ -153,8 +152,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     const cv::Mat1f map_fusion = std::move(fusion_made).value();
     timer.Mark("probability_map");
 
-    ProposalSet op =
-        MergeRegionBoxes(plain_regions, bundle.params.region_merge_iou, bundle.params.boxes.beta);
+    ProposalSet op = MergeRegionBoxes(plain_regions, bundle.params.region_merge_iou);
     const std::vector<Box> op_boxes = BoxesOf(op.boxes);
     const RegressedProposals op_reg =
         RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(op));

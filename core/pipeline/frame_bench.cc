@@ -63,8 +63,7 @@ Status CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchReco
     record.edge_pixels += stats.edge_pixels;
   }
   record.proposals = static_cast<long long>(
-      MergeRegionBoxes(per_region, bundle.params.region_merge_iou, bundle.params.boxes.beta)
-          .boxes.size());
+      MergeRegionBoxes(per_region, bundle.params.region_merge_iou).boxes.size());
 
   // E is the same map with or without the obstacle-aware enhancement, so the baseline scores
   // exactly the base edges our proposals start from. Its time includes the orientation and the

@@ -112,8 +112,8 @@ EdgeBoxParams RegionBoxParams(const EdgeBoxParams& box_params, int k, int num_la
   return params;
 }
 
-ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region, float merge_iou,
-                             float region_nms_iou) {
+ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region,
+                             float merge_iou) {
   std::vector<std::pair<ScoredBox, int>> merged;
   int min_x = 0, min_y = 0, max_x = 0, max_y = 0;
   for (std::size_t k = 0; k < per_region.size(); ++k)
@@ -129,21 +129,9 @@ ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_regi
   out.boxes.reserve(merged.size());
   out.layer.reserve(merged.size());
   const bool suppress = merge_iou < 1.f;
-  // Kept boxes per region (one set for all in the reference): a candidate is checked against the
-  // sets of the other regions only when its own region's NMS already settled their pairs.
-  const bool across_only = suppress && region_nms_iou <= merge_iou;
-  const int total = static_cast<int>(merged.size());
-  std::vector<GreedyNms> kept;
-  for (std::size_t k = 0; k < (across_only ? per_region.size() : 1); ++k)
-    kept.emplace_back(merge_iou, total, min_x, min_y, max_x, max_y);
+  GreedyNms nms(merge_iou, static_cast<int>(merged.size()), min_x, min_y, max_x, max_y);
   for (const auto& [box, k] : merged) {
-    if (suppress) {
-      bool suppressed = false;
-      for (std::size_t j = 0; j < kept.size() && !suppressed; ++j)
-        suppressed = (!across_only || static_cast<int>(j) != k) && kept[j].Suppresses(box.box);
-      if (suppressed) continue;
-      kept[across_only ? k : 0].Keep(box);
-    }
+    if (suppress && !nms.Offer(box)) continue;
     out.boxes.push_back(box);
     out.layer.push_back(k);
   }
@@ -234,7 +222,7 @@ ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& r
       propose(k, deadline);
     }
   }
-  ProposalSet out = MergeRegionBoxes(per_region, options.merge_iou, box_params.beta);
+  ProposalSet out = MergeRegionBoxes(per_region, options.merge_iou);
   for (int k = 0; k < used; ++k)
     if (truncated[k]) out.truncated_regions.push_back(k);
   return out;

@@ -97,12 +97,8 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
                                           EdgeBoxStats* stats = nullptr);
 // The union of per-region boxes (index = region), ranked by objectness, through a greedy NMS at
 // merge_iou across regions (1 = the plain union, as the authors' code); ties keep region order.
-// region_nms_iou: the NMS each region's list already went through (EdgeBoxParams::beta). When it
-// is at most merge_iou, two boxes of one region cannot suppress each other, so a box is only
-// checked against the kept boxes of the other regions (the same result, a fraction of the
-// checks); otherwise, or with region_nms_iou 1 (the reference), against every kept box.
-ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region, float merge_iou,
-                             float region_nms_iou);
+ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region,
+                             float merge_iou);
 
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                          const EdgeBoxParams& box_params, const ProposalOptions& options,

@@ -137,8 +137,7 @@ Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
                          : all;
     windows_scored += (filter ? stats : unfiltered_stats).windows_visited;
   }
-  ProposalSet merged =
-      MergeRegionBoxes(filtered, bundle.params.region_merge_iou, bundle.params.boxes.beta);
+  ProposalSet merged = MergeRegionBoxes(filtered, bundle.params.region_merge_iou);
   std::vector<Box> by_objectness;
   for (const ScoredBox& b : merged.boxes) by_objectness.push_back(b.box);
   const RegressedProposals reg =

@@ -203,8 +203,7 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
   }
   // After the cross-region merge, as the detector regresses them.
   counts["proposals_total"] =
-      MergeRegionBoxes(per_region, bundle.params.region_merge_iou, bundle.params.boxes.beta)
-          .boxes.size();
+      MergeRegionBoxes(per_region, bundle.params.region_merge_iou).boxes.size();
   return out;
 }
 

@@ -18,13 +18,6 @@ class GreedyNms {
 
   // Offers the next box in order (score descending); returns whether it was kept.
   bool Offer(const ScoredBox& box);
-  // Whether a kept box has IoU above the threshold with `candidate` (what Offer checks).
-  bool Suppresses(const Box& candidate) const { return Suppressed(candidate); }
-  // Keeps `box` unchecked (Offer without the check), for a caller that checked it elsewhere.
-  void Keep(const ScoredBox& box) {
-    Add(box.box);
-    kept_.push_back(box);
-  }
   bool full() const { return static_cast<int>(kept_.size()) >= max_boxes_; }
   const std::vector<ScoredBox>& kept() const { return kept_; }
   std::vector<ScoredBox> TakeKept() { return std::move(kept_); }
