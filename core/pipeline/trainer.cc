@@ -509,29 +509,25 @@ struct FrameRows {
   std::vector<int> ordr_bags, obdr_bags;
   long long proposals = 0;
 
-  int positives = 0;  // the first rows of both regressors are the shared positives
-
-  // Appends the positives of `more` (a pasted copy: its negatives would be the frame's road
-  // again, and its proposals are not counted).
-  void AppendPositives(const FrameRows& more) {
-    const int p = more.positives;
-    if (p == 0) return;
-    ordr.push_back(more.ordr.rowRange(0, p));
-    obdr.push_back(more.obdr.rowRange(0, p));
-    ordr_targets.insert(ordr_targets.end(), more.ordr_targets.begin(),
-                        more.ordr_targets.begin() + p);
-    obdr_targets.insert(obdr_targets.end(), more.obdr_targets.begin(),
-                        more.obdr_targets.begin() + p);
-    ordr_bags.insert(ordr_bags.end(), more.ordr_bags.begin(), more.ordr_bags.begin() + p);
-    obdr_bags.insert(obdr_bags.end(), more.obdr_bags.begin(), more.obdr_bags.begin() + p);
+  // Appends the rows of `more` (a pasted copy: its proposals are not counted).
+  void Append(const FrameRows& more) {
+    ordr.push_back(more.ordr);
+    obdr.push_back(more.obdr);
+    ordr_targets.insert(ordr_targets.end(), more.ordr_targets.begin(), more.ordr_targets.end());
+    obdr_targets.insert(obdr_targets.end(), more.obdr_targets.begin(), more.obdr_targets.end());
+    ordr_bags.insert(ordr_bags.end(), more.ordr_bags.begin(), more.ordr_bags.end());
+    obdr_bags.insert(obdr_bags.end(), more.obdr_bags.begin(), more.obdr_bags.end());
   }
 };
 
 // §6 on one frame: its proposals (maps by `upstream`'s classifiers), ranked by objectness or, with
-// `miner`, by the miner's fused score; the selected samples' features and targets.
+// `miner`, by the miner's fused score; the selected samples' features and targets. With
+// `positives_only` (a pasted copy: its negatives would be the frame's road again) the negatives
+// are dropped before any feature is computed.
 Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundle,
                                        const ModelBundle& upstream, const ModelBundle* miner,
-                                       const SampleSelectionParams& selection, std::uint64_t seed) {
+                                       const SampleSelectionParams& selection, std::uint64_t seed,
+                                       bool positives_only) {
   const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
       s.image, bundle.regions, *upstream.edges, &upstream.occlusion,
       OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), upstream.params, true);
@@ -548,6 +544,15 @@ Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundl
   }
   auto selected = SelectTrainingSamples(ranked, s, bundle.regions.RangeLimits(), selection, seed);
   if (!selected.ok()) return selected.status();
+  if (positives_only) {
+    // Positives come first in both lists, shared (SelectedSamples).
+    const std::size_t p = selected->positive_indices.size();
+    for (std::vector<int>* v : {&selected->ordr_indices, &selected->obdr_indices,
+                                &selected->ordr_bags, &selected->obdr_bags})
+      v->resize(p);
+    selected->ordr_targets.resize(p);
+    selected->obdr_targets.resize(p);
+  }
   const BoxFeatureOptions features = FeatureOptionsForFrame(bundle, s.image.cols, s.image.rows);
   FrameRows rows;
   rows.ordr = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
@@ -559,7 +564,6 @@ Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundl
   rows.ordr_bags = std::move(selected->ordr_bags);
   rows.obdr_bags = std::move(selected->obdr_bags);
   rows.proposals = static_cast<long long>(all.boxes.size());
-  rows.positives = static_cast<int>(selected->positive_indices.size());
   return rows;
 }
 
@@ -595,7 +599,8 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
         if (cv::countNonZero(s.road) > 0) {
           const ModelBundle& upstream = folds.For(bundle, i);
           const std::uint64_t seed = options.seed * 1000003ULL + static_cast<unsigned>(i);
-          auto rows = RegressorRowsOfFrame(s, bundle, upstream, miner, options.selection, seed);
+          auto rows = RegressorRowsOfFrame(s, bundle, upstream, miner, options.selection, seed,
+                                           /*positives_only=*/false);
           if (!rows.ok()) return rows.status();
           const std::vector<const ObstacleCutout*> donors =
               options.pasted_copies > 0 ? DonorsFor(i, survey, folds)
@@ -605,10 +610,10 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
             Sample pasted = PasteObstacles(s, donors, copy_seed, options.paste);
             if (pasted.instances.size() == s.instances.size()) continue;  // no place was free
             VoidOwnObstacles(pasted, s.instances.size());
-            auto more =
-                RegressorRowsOfFrame(pasted, bundle, upstream, miner, options.selection, copy_seed);
+            auto more = RegressorRowsOfFrame(pasted, bundle, upstream, miner, options.selection,
+                                             copy_seed, /*positives_only=*/true);
             if (!more.ok()) return more.status().WithContext("pasted copy " + std::to_string(copy));
-            rows->AppendPositives(*more);
+            rows->Append(*more);
           }
           proposals[i] = rows->proposals;
           out.ordr_rows[i] = std::move(rows->ordr);
