@@ -121,7 +121,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     if (!computed.ok()) return computed.status();
     const OcclusionEdges& oaocc = *computed;
     const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
-    std::vector<std::vector<ScoredBox>> ms_regions;
+    std::vector<RegionProposals> ms_regions;
     for (int k = 0; k < layers; ++k)
       ms_regions.push_back(
           ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k, true, filter));
@@ -129,12 +129,12 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     timer.Mark("proposals");
     // R1's stride factor is 1 with and without MS, so its boxes serve OAOCC+OLP@1 and OP too;
     // only R2..RK are scored again without MS.
-    const std::vector<Box> oaocc1 = BoxesOf(ms_regions.front());
-    std::vector<std::vector<ScoredBox>> plain_regions = {ms_regions.front()};
+    const std::vector<Box> oaocc1 = BoxesOf(ms_regions.front().boxes);
+    std::vector<RegionProposals> plain_regions = {ms_regions.front()};
     for (int k = 1; k < layers; ++k)
       plain_regions.push_back(
           ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k, false, filter));
-    const std::vector<Box> bp_boxes = BoxesOf(bp.boxes);
+    const std::vector<Box> bp_boxes = RankedOnCommonScale(bp);
     const RegressedProposals bp_reg =
         RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(bp), &timer);
     const std::vector<float> fused = FuseScores(bp_reg.ordr, bp_reg.obdr, bundle.params.fusion);
@@ -153,7 +153,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
     timer.Mark("probability_map");
 
     ProposalSet op = MergeRegionBoxes(plain_regions, bundle.params.region_merge_iou);
-    const std::vector<Box> op_boxes = BoxesOf(op.boxes);
+    const std::vector<Box> op_boxes = RankedOnCommonScale(op);
     const RegressedProposals op_reg =
         RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(op));
     std::vector<ScoredBox> op_ordr(op_reg.ordr.size());

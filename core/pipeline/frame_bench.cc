@@ -52,7 +52,7 @@ Status CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchReco
   if (!computed.ok()) return computed.status().WithContext("counting the work");
   const OcclusionEdges& oaocc = *computed;
   const SizeFilter* size_filter = bundle.params.size_filter ? &geometry.size_filter : nullptr;
-  std::vector<std::vector<ScoredBox>> per_region;
+  std::vector<RegionProposals> per_region;
   for (int k = 0; k < geometry.regions.num_layers(); ++k) {
     EdgeBoxStats stats;
     per_region.push_back(ProposeRegionBoxes(oaocc, geometry.regions, bundle.params.boxes, k,

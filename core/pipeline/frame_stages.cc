@@ -78,17 +78,17 @@ cv::Mat1f RegionEdgeMap(const OcclusionEdges& oaocc, const MultilayerRegions& re
   return map;
 }
 
-std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
-                                          const MultilayerRegions& regions,
-                                          const EdgeBoxParams& box_params, int k, bool multistride,
-                                          const SizeFilter* size_filter, EdgeBoxStats* stats) {
+RegionProposals ProposeRegionBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                                   const EdgeBoxParams& box_params, int k, bool multistride,
+                                   const SizeFilter* size_filter, EdgeBoxStats* stats) {
   if (stats != nullptr) *stats = EdgeBoxStats{};
-  // Normalised straight from the region's copy: one map is held while the windows are scored.
-  const cv::Mat1f map = NormaliseToMax(RegionEdgeMap(oaocc, regions, k));
-  if (map.empty()) return {};
+  RegionProposals out;
+  cv::Mat1f map = RegionEdgeMap(oaocc, regions, k);
+  if (map.empty()) return out;
+  out.edge_max = MaxFiniteValue(map);
+  map = NormaliseToMax(map);
   const EdgeBoxParams params = RegionBoxParams(box_params, k, regions.num_layers(), multistride);
   const Box region = Intersect(regions.layers[k], oaocc.r1);
-  std::vector<ScoredBox> out;
   const bool filtered = size_filter != nullptr && size_filter->enabled;
   // Windows that cannot end as a kept box are not scored. Unlike the authors' order (NMS, the
   // max_boxes cut, then the filter), filtered boxes thus neither suppress kept ones in NMS nor
@@ -99,7 +99,7 @@ std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
     b.box.x += region.x;
     b.box.y += region.y;
     if (filtered && !size_filter->Keep(b.box)) continue;
-    out.push_back(b);
+    out.boxes.push_back(b);
   }
   return out;
 }
@@ -112,12 +112,27 @@ EdgeBoxParams RegionBoxParams(const EdgeBoxParams& box_params, int k, int num_la
   return params;
 }
 
-ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region,
-                             float merge_iou) {
+namespace {
+
+// Per region, the factor that puts its scores on the scale of the region whose map peaks
+// highest (R1, which holds the others): edge_max / the largest edge_max; 1 when no map has an
+// edge.
+std::vector<float> CommonScoreScales(const std::vector<RegionProposals>& per_region) {
+  float largest = 0.f;
+  for (const RegionProposals& r : per_region) largest = std::max(largest, r.edge_max);
+  std::vector<float> scales(per_region.size(), 1.f);
+  if (largest <= 0.f) return scales;
+  for (std::size_t k = 0; k < per_region.size(); ++k) scales[k] = per_region[k].edge_max / largest;
+  return scales;
+}
+
+}  // namespace
+
+ProposalSet MergeRegionBoxes(const std::vector<RegionProposals>& per_region, float merge_iou) {
   std::vector<std::pair<ScoredBox, int>> merged;
   int min_x = 0, min_y = 0, max_x = 0, max_y = 0;
   for (std::size_t k = 0; k < per_region.size(); ++k)
-    for (const ScoredBox& b : per_region[k]) {
+    for (const ScoredBox& b : per_region[k].boxes) {
       if (merged.empty()) min_x = max_x = b.box.x, min_y = max_y = b.box.y;
       min_x = std::min(min_x, b.box.x), max_x = std::max(max_x, b.box.x);
       min_y = std::min(min_y, b.box.y), max_y = std::max(max_y, b.box.y);
@@ -128,6 +143,7 @@ ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_regi
   ProposalSet out;
   out.boxes.reserve(merged.size());
   out.layer.reserve(merged.size());
+  out.layer_scale = CommonScoreScales(per_region);
   const bool suppress = merge_iou < 1.f;
   GreedyNms nms(merge_iou, static_cast<int>(merged.size()), min_x, min_y, max_x, max_y);
   for (const auto& [box, k] : merged) {
@@ -136,6 +152,22 @@ ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_regi
     out.layer.push_back(k);
   }
   return out;
+}
+
+std::vector<Box> RankedOnCommonScale(const ProposalSet& proposals) {
+  const auto scale_of = [&](std::size_t i) {
+    const int k = proposals.layer[i];
+    return k < static_cast<int>(proposals.layer_scale.size()) ? proposals.layer_scale[k] : 1.f;
+  };
+  std::vector<std::pair<float, std::size_t>> keyed(proposals.boxes.size());
+  for (std::size_t i = 0; i < keyed.size(); ++i)
+    keyed[i] = {proposals.boxes[i].score * scale_of(i), i};
+  std::stable_sort(keyed.begin(), keyed.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<Box> ranked;
+  ranked.reserve(keyed.size());
+  for (const auto& [key, i] : keyed) ranked.push_back(proposals.boxes[i].box);
+  return ranked;
 }
 
 ProposalOptions DetectorProposalOptions(const PipelineParams& params, int layers) {
@@ -184,7 +216,7 @@ ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& r
   const std::vector<double> windows =
       RegionWindowCounts(oaocc, regions, box_params, used, options.multistride);
   const SizeFilter* filter = options.size_filter ? &size_filter : nullptr;
-  std::vector<std::vector<ScoredBox>> per_region(used);
+  std::vector<RegionProposals> per_region(used);
   std::vector<char> truncated(used, 0);
   const auto propose = [&](int k, Clock::time_point deadline) {
     EdgeBoxParams params = box_params;

@@ -76,8 +76,13 @@ struct ProposalOptions {
 ProposalOptions DetectorProposalOptions(const PipelineParams& params, int layers);
 
 struct ProposalSet {
-  std::vector<ScoredBox> boxes;  // full-image coordinates, objectness descending
-  std::vector<int> layer;        // 0-based region that produced each box
+  // Full-image coordinates, in the merge's order (MergeRegionBoxes): each box's score is its own
+  // region's Edge Boxes score.
+  std::vector<ScoredBox> boxes;
+  std::vector<int> layer;  // 0-based region that produced each box
+  // Per region: the factor that puts its scores on the scale of the region whose map peaks
+  // highest (its map's maximum over the largest; 1 when no map has an edge). Empty: all 1.
+  std::vector<float> layer_scale;
   // Regions (0-based) whose window scan the deadline cut short.
   std::vector<int> truncated_regions;
 };
@@ -87,18 +92,31 @@ struct ProposalSet {
 EdgeBoxParams RegionBoxParams(const EdgeBoxParams& box_params, int k, int num_layers,
                               bool multistride);
 
+// One region's proposals. Edge Boxes scores a region on its map divided by the map's maximum
+// (§4.2), so a box's score is in units of its own region's `edge_max`.
+struct RegionProposals {
+  std::vector<ScoredBox> boxes;  // full-image coordinates, objectness descending
+  float edge_max = 0.f;          // largest value of the region's occlusion-edge map
+};
+
 // Boxes of region k (0-based) in full-image coordinates, objectness descending, through the size
 // filter when one is given. `stats` (may be null) receives the scorer's counters for the region
 // (boxes_out counts the boxes before the size filter's final pass).
-std::vector<ScoredBox> ProposeRegionBoxes(const OcclusionEdges& oaocc,
-                                          const MultilayerRegions& regions,
-                                          const EdgeBoxParams& box_params, int k, bool multistride,
-                                          const SizeFilter* size_filter,
-                                          EdgeBoxStats* stats = nullptr);
-// The union of per-region boxes (index = region), ranked by objectness, through a greedy NMS at
-// merge_iou across regions (1 = the plain union, as the authors' code); ties keep region order.
-ProposalSet MergeRegionBoxes(const std::vector<std::vector<ScoredBox>>& per_region,
-                             float merge_iou);
+RegionProposals ProposeRegionBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                                   const EdgeBoxParams& box_params, int k, bool multistride,
+                                   const SizeFilter* size_filter, EdgeBoxStats* stats = nullptr);
+// The union of per-region boxes (index = region), ordered by their regions' scores (ties keep
+// region order), through a greedy NMS at merge_iou across regions (1 = the plain union, as the
+// authors' code). Of a window found by several regions, NMS thus keeps the copy of the region
+// where it stands out most against that region's peak, usually the innermost: its features
+// come from the map the paper made that region for. Sets layer_scale from the regions' edge_max.
+ProposalSet MergeRegionBoxes(const std::vector<RegionProposals>& per_region, float merge_iou);
+
+// The proposals' boxes ranked by objectness on one scale across regions (score times its
+// region's layer_scale), ties in list order: the ranking average recall reads. The regions'
+// own scores are in units of their own maps' maxima, so ranked as they are, a region whose map
+// peaks lower put its boxes above the same windows found by the regions around it.
+std::vector<Box> RankedOnCommonScale(const ProposalSet& proposals);
 
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                          const EdgeBoxParams& box_params, const ProposalOptions& options,

@@ -124,22 +124,21 @@ Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
   const OcclusionEdges& oaocc = *computed;
   const int layers = geo.regions.num_layers();
   std::vector<ScoredBox> unfiltered;
-  std::vector<std::vector<ScoredBox>> filtered(layers);
+  std::vector<RegionProposals> filtered(layers);
   const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
   long long windows_scored = 0;  // as the detector scores them (size filter admission on)
   for (int k = 0; k < layers; ++k) {
     EdgeBoxStats unfiltered_stats, stats;
     const auto all = ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k,
                                         bundle.params.multistride, nullptr, &unfiltered_stats);
-    unfiltered.insert(unfiltered.end(), all.begin(), all.end());
+    unfiltered.insert(unfiltered.end(), all.boxes.begin(), all.boxes.end());
     filtered[k] = filter ? ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k,
                                               bundle.params.multistride, filter, &stats)
                          : all;
     windows_scored += (filter ? stats : unfiltered_stats).windows_visited;
   }
   ProposalSet merged = MergeRegionBoxes(filtered, bundle.params.region_merge_iou);
-  std::vector<Box> by_objectness;
-  for (const ScoredBox& b : merged.boxes) by_objectness.push_back(b.box);
+  const std::vector<Box> by_objectness = RankedOnCommonScale(merged);
   const RegressedProposals reg =
       RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(merged));
   const std::vector<float> fused = FuseScores(reg.ordr, reg.obdr, bundle.params.fusion);
@@ -175,7 +174,7 @@ Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
     f.best_iou_unfiltered = BestIoU(unfiltered, inst.box);
     double best_filtered = 0;
     for (const auto& region_boxes : filtered)
-      best_filtered = std::max(best_filtered, BestIoU(region_boxes, inst.box));
+      best_filtered = std::max(best_filtered, BestIoU(region_boxes.boxes, inst.box));
     f.best_iou_filtered = best_filtered;
     f.proposal_rank = FirstHit(by_objectness, inst.box, options.hit_iou, options.top_n);
     f.regressed_rank = FirstHit(by_fused, inst.box, options.hit_iou, options.top_n);

@@ -178,11 +178,12 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
   counts["superpixels"] = oaocc.superpixels.count;
   counts["occlusion_edge_pixels"] = CountAbove(oaocc.occlusion, options.edge_threshold);
   counts["regions"] = nlohmann::json::array();
-  std::vector<std::vector<ScoredBox>> per_region;
+  std::vector<RegionProposals> per_region;
   for (int k = 0; k < layers; ++k) {
     EdgeBoxStats stats;
-    const std::vector<ScoredBox> boxes = ProposeRegionBoxes(
-        oaocc, regions, bundle.params.boxes, k, bundle.params.multistride, size_filter, &stats);
+    RegionProposals proposals = ProposeRegionBoxes(oaocc, regions, bundle.params.boxes, k,
+                                                   bundle.params.multistride, size_filter, &stats);
+    const std::vector<ScoredBox>& boxes = proposals.boxes;
     const int drawn =
         std::min(std::max(0, options.proposals_drawn), static_cast<int>(boxes.size()));
     out.images.push_back(
@@ -199,7 +200,7 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
     region["proposals_kept"] = boxes.size();
     region["proposals_drawn"] = drawn;
     counts["regions"].push_back(std::move(region));
-    per_region.push_back(boxes);
+    per_region.push_back(std::move(proposals));
   }
   // After the cross-region merge, as the detector regresses them.
   counts["proposals_total"] =

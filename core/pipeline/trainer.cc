@@ -485,6 +485,7 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
 // Rows of ProposalSet `all` selected by `indices`, as a proposal subset for feature extraction.
 ProposalSet Subset(const ProposalSet& all, const std::vector<int>& indices) {
   ProposalSet out;
+  out.layer_scale = all.layer_scale;
   for (int i : indices) {
     out.boxes.push_back(all.boxes[i]);
     out.layer.push_back(all.layer[i]);

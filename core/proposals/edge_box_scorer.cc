@@ -84,7 +84,7 @@ float ScoreSingleBox(const cv::Mat1f& edge_map, const Box& box, const EdgeBoxPar
   return w.score;
 }
 
-cv::Mat1f NormaliseToMax(const cv::Mat1f& map) {
+float MaxFiniteValue(const cv::Mat1f& map) {
   float max_value = 0.f;
   for (int r = 0; r < map.rows; ++r) {
     const float* row = map[r];
@@ -92,6 +92,11 @@ cv::Mat1f NormaliseToMax(const cv::Mat1f& map) {
       if (row[c] > max_value && std::isfinite(row[c])) max_value = row[c];  // NaN/inf ignored
     }
   }
+  return max_value;
+}
+
+cv::Mat1f NormaliseToMax(const cv::Mat1f& map) {
+  const float max_value = MaxFiniteValue(map);
   if (max_value <= 0.f) return map.clone();
   cv::Mat1f out;
   map.convertTo(out, CV_32F, 1.0 / max_value);

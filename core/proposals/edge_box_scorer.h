@@ -92,7 +92,9 @@ std::vector<ScoredBox> ScoreEdgeBoxes(const cv::Mat1f& edge_map, const EdgeBoxPa
 // The box is clipped to the map; 0 for an empty box, empty map or invalid parameters.
 float ScoreSingleBox(const cv::Mat1f& edge_map, const Box& box, const EdgeBoxParams& params);
 
-// M / max(M) (unchanged when max is 0).
+// The largest finite value of the map (NaN and inf ignored); 0 for an empty or all-zero map.
+float MaxFiniteValue(const cv::Mat1f& map);
+// M / max(M), max = MaxFiniteValue(M) (unchanged when max is 0).
 cv::Mat1f NormaliseToMax(const cv::Mat1f& map);
 
 // §3.2(4): zero boundary pixels on the outermost rows / columns of a region crop that merely run
