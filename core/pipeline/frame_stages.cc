@@ -209,9 +209,9 @@ std::vector<int> LargestFirst(const std::vector<double>& windows) {
 
 }  // namespace
 
-ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
-                         const EdgeBoxParams& box_params, const ProposalOptions& options,
-                         const SizeFilter& size_filter) {
+FrameRegionProposals ProposeRegions(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                                    const EdgeBoxParams& box_params, const ProposalOptions& options,
+                                    const SizeFilter& size_filter) {
   const int used = std::clamp(options.layers_used, 1, regions.num_layers());
   const std::vector<double> windows =
       RegionWindowCounts(oaocc, regions, box_params, used, options.multistride);
@@ -254,9 +254,19 @@ ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& r
       propose(k, deadline);
     }
   }
-  ProposalSet out = MergeRegionBoxes(per_region, options.merge_iou);
+  FrameRegionProposals out;
+  out.per_region = std::move(per_region);
   for (int k = 0; k < used; ++k)
     if (truncated[k]) out.truncated_regions.push_back(k);
+  return out;
+}
+
+ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                         const EdgeBoxParams& box_params, const ProposalOptions& options,
+                         const SizeFilter& size_filter) {
+  FrameRegionProposals found = ProposeRegions(oaocc, regions, box_params, options, size_filter);
+  ProposalSet out = MergeRegionBoxes(found.per_region, options.merge_iou);
+  out.truncated_regions = std::move(found.truncated_regions);
   return out;
 }
 

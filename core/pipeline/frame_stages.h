@@ -118,6 +118,17 @@ ProposalSet MergeRegionBoxes(const std::vector<RegionProposals>& per_region, flo
 // peaks lower put its boxes above the same windows found by the regions around it.
 std::vector<Box> RankedOnCommonScale(const ProposalSet& proposals);
 
+// Every used region's boxes (ProposeRegionBoxes), before the merge: up to options.threads regions
+// side by side, each scanned with that many threads; the same boxes for any count.
+struct FrameRegionProposals {
+  std::vector<RegionProposals> per_region;  // index = region
+  std::vector<int> truncated_regions;       // as ProposalSet's
+};
+FrameRegionProposals ProposeRegions(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
+                                    const EdgeBoxParams& box_params, const ProposalOptions& options,
+                                    const SizeFilter& size_filter);
+
+// ProposeRegions, then MergeRegionBoxes.
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                          const EdgeBoxParams& box_params, const ProposalOptions& options,
                          const SizeFilter& size_filter);

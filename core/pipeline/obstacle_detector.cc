@@ -140,16 +140,36 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
       DetectorProposalOptions(bundle_.params, geometry.regions.num_layers());
   proposal_options.deadline = budget.ProposalsDeadline();
   proposal_options.threads = threads;
-  ProposalSet proposals = ProposeBoxes(oaocc, geometry.regions, bundle_.params.boxes,
-                                       proposal_options, geometry.size_filter);
+  FrameRegionProposals found = ProposeRegions(oaocc, geometry.regions, bundle_.params.boxes,
+                                              proposal_options, geometry.size_filter);
+  // The regions' merge is one thread's work (a greedy NMS over some 30 000 boxes). R1's colour
+  // tables for the features read the image alone, so a second thread builds them meanwhile; one
+  // thread builds them at the features stage. Either way the same tables. (Started with the
+  // frame or after the edges, the tables slowed the stages they ran beside, whose stripes and
+  // chained sweeps wait for their slowest thread; README, Speed.)
+  ProposalSet proposals;
+  FrameColourTables colour_tables;
+  const auto merge_or_tables = [&](int task) {
+    if (task == 0) {
+      proposals = MergeRegionBoxes(found.per_region, proposal_options.merge_iou);
+      proposals.truncated_regions = std::move(found.truncated_regions);
+    } else {
+      colour_tables = BuildFrameColourTables(bgr, oaocc.r1,
+                                             FeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows));
+    }
+    return Status::Ok();
+  };
+  for (const Status& s : ParallelFor(threads > 1 ? 2 : 1, 2, merge_or_tables))
+    if (!s.ok()) return s;
+  found = {};
   timer.Mark("proposals");
   if (!timer.stopped().ok()) return timer.stopped();
   Detection out;
   if (oaocc.occlusion_cut_short) out.degraded_stages.push_back("occlusion");
   if (!proposals.truncated_regions.empty()) out.degraded_stages.push_back("proposals");
-  RegressedProposals regressed =
-      RegressProposals(bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer,
-                       {.deadline = budget.RegressionDeadline(), .threads = threads});
+  RegressedProposals regressed = RegressProposals(
+      bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer,
+      {.deadline = budget.RegressionDeadline(), .threads = threads}, std::move(colour_tables));
   if (!timer.stopped().ok()) return timer.stopped();
   if (regressed.truncated) out.degraded_stages.push_back("regression");
   const std::vector<float> fused =

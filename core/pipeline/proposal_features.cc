@@ -9,24 +9,32 @@
 
 namespace tod {
 
+FrameColourTables BuildFrameColourTables(const cv::Mat3b& image, const Box& r1,
+                                         const BoxFeatureOptions& options) {
+  const cv::Mat3b r1_bgr = image(r1.rect());
+  const cv::Point r1_origin(r1.x, r1.y);
+  FrameColourTables tables;
+  tables.colour = std::make_shared<const ColourIntegrals>(r1_bgr, r1_origin);
+  if (options.vertical_edges || options.orientation_entropy) {
+    tables.vertical = std::make_shared<const VerticalEdgeIntegrals>(
+        r1_bgr, r1_origin, VerticalEdgeParams{.orientation_tables = options.orientation_entropy});
+  }
+  return tables;
+}
+
 ProposalFeatureComputer::ProposalFeatureComputer(const cv::Mat3b& image,
                                                  const OcclusionEdges& oaocc,
                                                  const MultilayerRegions& regions,
                                                  const ProposalSet& proposals,
-                                                 const BoxFeatureOptions& options, int threads)
+                                                 const BoxFeatureOptions& options, int threads,
+                                                 FrameColourTables colour)
     : proposals_(proposals), per_region_(regions.num_layers()) {
   if (proposals.boxes.empty()) return;
   std::vector<bool> used(regions.num_layers(), false);
   for (const int k : proposals.layer) used[k] = true;
-  const cv::Mat3b r1_bgr = image(oaocc.r1.rect());
-  const cv::Point r1_origin(oaocc.r1.x, oaocc.r1.y);
-  const auto frame_colour = std::make_shared<const ColourIntegrals>(r1_bgr, r1_origin);
-  const auto frame_vertical =
-      options.vertical_edges || options.orientation_entropy
-          ? std::make_shared<const VerticalEdgeIntegrals>(
-                r1_bgr, r1_origin,
-                VerticalEdgeParams{.orientation_tables = options.orientation_entropy})
-          : nullptr;
+  if (colour.colour == nullptr) colour = BuildFrameColourTables(image, oaocc.r1, options);
+  const std::shared_ptr<const ColourIntegrals>& frame_colour = colour.colour;
+  const std::shared_ptr<const VerticalEdgeIntegrals>& frame_vertical = colour.vertical;
   // Each region's edge tables are one pass over its map, independent of the others.
   for (const Status& s : ParallelFor(regions.num_layers(), threads, [&](int k) {
          if (!used[k]) return Status::Ok();

@@ -38,7 +38,7 @@ void SplitRange(std::size_t begin, std::size_t end, int threads, Body body) {
 RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& image,
                                     const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                                     ProposalSet proposals, StageTimer* timer,
-                                    const RegressionLimits& limits) {
+                                    const RegressionLimits& limits, FrameColourTables colour) {
   using Clock = std::chrono::steady_clock;
   RegressedProposals out;
   const std::size_t n = proposals.boxes.size();
@@ -46,7 +46,7 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   cv::Mat1f features(static_cast<int>(n), NumBoxFeatures(feature_options), 0.f);
   out.ordr.assign(n, 0.f);
   const ProposalFeatureComputer computer(image, oaocc, regions, proposals, feature_options,
-                                         limits.threads);
+                                         limits.threads, std::move(colour));
   std::size_t done = 0;
   Clock::duration feature_time{};
   while (done < n) {

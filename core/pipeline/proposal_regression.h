@@ -8,6 +8,7 @@
 #include "core/base/stage_timer.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/model_bundle.h"
+#include "core/pipeline/proposal_features.h"
 
 namespace tod {
 
@@ -31,10 +32,12 @@ struct RegressionLimits {
 // ORDR and OBDR scores of every proposal (features computed here); OBDR only on the boxes that
 // pass the fusion gate (the rest keep 0). The timer (may be null) gets "features" and
 // "regression" marks; when its check stops the frame, the result is incomplete and the caller
-// returns timer->stopped().
+// returns timer->stopped(). `colour`: R1's colour tables when already built for the bundle's
+// feature options (FeatureOptionsForFrame), else empty.
 RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& image,
                                     const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                                     ProposalSet proposals, StageTimer* timer = nullptr,
-                                    const RegressionLimits& limits = {});
+                                    const RegressionLimits& limits = {},
+                                    FrameColourTables colour = {});
 
 }  // namespace tod

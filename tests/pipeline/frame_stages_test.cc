@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/pipeline/frame_geometry.h"
+#include "core/pipeline/proposal_features.h"
 #include "tests/pipeline/tiny_bundle.h"
 
 namespace tod {
@@ -124,6 +125,42 @@ TEST(FrameStagesTest, RegionsSideBySideGiveTheBoxesOfOneThread) {
     }
     EXPECT_TRUE(several.truncated_regions.empty());
   }
+}
+
+// The detector builds R1's colour tables beside the regions' merge and hands them to the
+// features; the rows must be those of tables built by the feature computer itself.
+TEST(FrameStagesTest, ColourTablesBuiltBeforehandGiveTheSameFeatures) {
+  const ModelBundle bundle = TinyBundle();
+  const cv::Mat3b frame = RoadFrame(512, 256);
+  const FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
+  const Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
+      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
+      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
+  ASSERT_TRUE(oaocc.ok()) << oaocc.status().ToString();
+  const ProposalSet proposals = ProposeBoxes(
+      *oaocc, geometry.regions, bundle.params.boxes,
+      DetectorProposalOptions(bundle.params, geometry.regions.num_layers()), geometry.size_filter);
+  ASSERT_GT(proposals.boxes.size(), 0u);
+  BoxFeatureOptions options = FeatureOptionsForFrame(bundle, frame.cols, frame.rows);
+  options.vertical_edges = true;  // both tables
+  const auto rows_with = [&](FrameColourTables colour) {
+    cv::Mat1f rows(static_cast<int>(proposals.boxes.size()), NumBoxFeatures(options), 0.f);
+    ProposalFeatureComputer(frame, *oaocc, geometry.regions, proposals, options, 1,
+                            std::move(colour))
+        .ComputeRange(0, proposals.boxes.size(), rows);
+    return rows;
+  };
+  const cv::Mat1f inside = rows_with({});
+  const FrameColourTables beforehand = BuildFrameColourTables(frame, oaocc->r1, options);
+  ASSERT_NE(beforehand.colour, nullptr);
+  ASSERT_NE(beforehand.vertical, nullptr);
+  const cv::Mat1f handed = rows_with(beforehand);
+  ASSERT_EQ(handed.size(), inside.size());
+  EXPECT_EQ(cv::norm(handed, inside, cv::NORM_INF), 0.0);
+  // The handed tables are the ones read: tables of another image give other rows.
+  const cv::Mat3b inverted = cv::Scalar::all(255) - frame;
+  const cv::Mat1f other = rows_with(BuildFrameColourTables(inverted, oaocc->r1, options));
+  EXPECT_GT(cv::norm(other, inside, cv::NORM_INF), 0.0);
 }
 
 }  // namespace
