@@ -15,13 +15,19 @@
 namespace tod {
 namespace {
 
-TEST(FrameStagesTest, ComputesEveryMapOnR1) {
-  const ModelBundle bundle = TinyBundle();
-  const cv::Mat3b frame = RoadFrame(512, 256);
-  const FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
-  const Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
+// The tiny bundle's maps of a 512 x 256 road frame, as the detector computes them.
+struct RoadFrameMaps {
+  ModelBundle bundle = TinyBundle();
+  cv::Mat3b frame = RoadFrame(512, 256);
+  FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
+  Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
       frame, geometry.regions, *bundle.edges, &bundle.occlusion,
       OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
+};
+
+TEST(FrameStagesTest, ComputesEveryMapOnR1) {
+  const RoadFrameMaps maps;
+  const Result<OcclusionEdges>& oaocc = maps.oaocc;
   ASSERT_TRUE(oaocc.ok()) << oaocc.status().ToString();
   const cv::Size crop = oaocc->r1.rect().size();
   EXPECT_EQ(oaocc->base_edge.size(), crop);
@@ -96,13 +102,9 @@ TEST(FrameStagesTest, SuperpixelStageRejectingItsParametersIsAnError) {
 // With several threads the regions are scanned side by side (and each scan split over the
 // threads): the boxes, their order and their regions are those of one thread.
 TEST(FrameStagesTest, RegionsSideBySideGiveTheBoxesOfOneThread) {
-  const ModelBundle bundle = TinyBundle();
-  const cv::Mat3b frame = RoadFrame(512, 256);
-  const FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
+  const RoadFrameMaps maps;
+  const auto& [bundle, frame, geometry, oaocc] = maps;
   ASSERT_GE(geometry.regions.num_layers(), 2);
-  const Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
-      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
   ASSERT_TRUE(oaocc.ok()) << oaocc.status().ToString();
   const auto propose = [&](int threads) {
     ProposalOptions options = DetectorProposalOptions(bundle.params, geometry.regions.num_layers());
@@ -130,12 +132,8 @@ TEST(FrameStagesTest, RegionsSideBySideGiveTheBoxesOfOneThread) {
 // The detector builds R1's colour tables beside the regions' merge and hands them to the
 // features; the rows must be those of tables built by the feature computer itself.
 TEST(FrameStagesTest, ColourTablesBuiltBeforehandGiveTheSameFeatures) {
-  const ModelBundle bundle = TinyBundle();
-  const cv::Mat3b frame = RoadFrame(512, 256);
-  const FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
-  const Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
-      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
+  const RoadFrameMaps maps;
+  const auto& [bundle, frame, geometry, oaocc] = maps;
   ASSERT_TRUE(oaocc.ok()) << oaocc.status().ToString();
   const ProposalSet proposals = ProposeBoxes(
       *oaocc, geometry.regions, bundle.params.boxes,
