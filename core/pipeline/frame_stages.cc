@@ -264,8 +264,12 @@ FrameRegionProposals ProposeRegions(const OcclusionEdges& oaocc, const Multilaye
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                          const EdgeBoxParams& box_params, const ProposalOptions& options,
                          const SizeFilter& size_filter) {
-  FrameRegionProposals found = ProposeRegions(oaocc, regions, box_params, options, size_filter);
-  ProposalSet out = MergeRegionBoxes(found.per_region, options.merge_iou);
+  return MergeFrameRegions(ProposeRegions(oaocc, regions, box_params, options, size_filter),
+                           options.merge_iou);
+}
+
+ProposalSet MergeFrameRegions(FrameRegionProposals found, float merge_iou) {
+  ProposalSet out = MergeRegionBoxes(found.per_region, merge_iou);
   out.truncated_regions = std::move(found.truncated_regions);
   return out;
 }

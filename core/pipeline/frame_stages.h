@@ -128,7 +128,10 @@ FrameRegionProposals ProposeRegions(const OcclusionEdges& oaocc, const Multilaye
                                     const EdgeBoxParams& box_params, const ProposalOptions& options,
                                     const SizeFilter& size_filter);
 
-// ProposeRegions, then MergeRegionBoxes.
+// MergeRegionBoxes of the frame's regions, with their truncated_regions.
+ProposalSet MergeFrameRegions(FrameRegionProposals found, float merge_iou);
+
+// ProposeRegions, then MergeFrameRegions.
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                          const EdgeBoxParams& box_params, const ProposalOptions& options,
                          const SizeFilter& size_filter);

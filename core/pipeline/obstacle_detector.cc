@@ -151,8 +151,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   FrameColourTables colour_tables;
   const auto merge_or_tables = [&](int task) {
     if (task == 0) {
-      proposals = MergeRegionBoxes(found.per_region, proposal_options.merge_iou);
-      proposals.truncated_regions = std::move(found.truncated_regions);
+      proposals = MergeFrameRegions(std::move(found), proposal_options.merge_iou);
     } else {
       colour_tables = BuildFrameColourTables(bgr, oaocc.r1,
                                              FeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows));
@@ -161,7 +160,6 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   };
   for (const Status& s : ParallelFor(threads > 1 ? 2 : 1, 2, merge_or_tables))
     if (!s.ok()) return s;
-  found = {};
   timer.Mark("proposals");
   if (!timer.stopped().ok()) return timer.stopped();
   Detection out;
