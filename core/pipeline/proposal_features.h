@@ -19,7 +19,7 @@ class VerticalEdgeIntegrals;
 
 // R1's colour tables, shared by every region's features: the colour integrals (features 15-20)
 // and, when the options ask for them, the vertical edge integrals (21-22). They read the image
-// alone, so a detector with threads to spare builds them beside the edge and proposal stages.
+// alone, so a detector with threads to spare builds them beside the regions' merge.
 struct FrameColourTables {
   std::shared_ptr<const ColourIntegrals> colour;
   std::shared_ptr<const VerticalEdgeIntegrals> vertical;  // null when the options need none
