@@ -8,20 +8,30 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "core/base/row_bands.h"
+
 namespace tod {
 
+// In bands of rows on OpenCV's pool: the conversion, cv::cvtColor (which splits large images
+// itself but not the conversion to float or the scaling) and the scaling are per pixel, so the
+// bands give the pixels of one call over the whole image.
 cv::Mat3f BgrToLuv(const cv::Mat3b& bgr) {
   if (bgr.empty()) return {};
-  cv::Mat3f bgr_unit;
-  bgr.convertTo(bgr_unit, CV_32F, 1.0 / 255.0);
-  cv::Mat3f luv;
-  // Float input gives L in [0,100] and u, v in roughly [-134,220]; one common scale keeps the
-  // channels comparable.
-  cv::cvtColor(bgr_unit, luv, cv::COLOR_BGR2Luv);
-  luv *= 0.01f;
+  cv::Mat3f luv(bgr.size());
+  ForEachRowBand(bgr.rows, [&](const cv::Range& rows) {
+    cv::Mat3f bgr_unit;
+    bgr.rowRange(rows).convertTo(bgr_unit, CV_32F, 1.0 / 255.0);
+    cv::Mat band = luv.rowRange(rows);
+    // Float input gives L in [0,100] and u, v in roughly [-134,220]; one common scale keeps the
+    // channels comparable.
+    cv::cvtColor(bgr_unit, band, cv::COLOR_BGR2Luv);
+    band *= 0.01f;
+  });
   return luv;
 }
 
+// Bands of rows on OpenCV's pool, each pixel that of one filter call over the whole image
+// (row_bands.h).
 cv::Mat TriangleSmooth(const cv::Mat& src, int radius) {
   if (radius <= 0 || src.empty()) return src.clone();
   const int taps = 2 * radius + 1;
@@ -30,9 +40,7 @@ cv::Mat TriangleSmooth(const cv::Mat& src, int radius) {
   for (int i = 0; i < taps; ++i) {
     kernel(0, i) = static_cast<float>(radius + 1 - std::abs(i - radius)) * norm;
   }
-  cv::Mat out;
-  cv::sepFilter2D(src, out, -1, kernel, kernel, cv::Point(-1, -1), 0, cv::BORDER_REFLECT);
-  return out;
+  return SepFilterInRowBands(src, kernel, kernel);
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/base/row_bands.h"
 #include "core/edges/superpixel_boundaries.h"
 #include "core/edges/superpixel_refine.h"
 
@@ -26,22 +27,11 @@ std::vector<int> OneLabelPerPixel(int width, int height) {
 
 }  // namespace
 
-// OpenCV runs this filter on one thread; bands of rows run on its pool instead. A band is a view
-// into the whole image, and OpenCV's filters read the rows beyond a view from its parent (the
-// border rule applies at the image's own edges only), so every band's pixels are those of one
-// call over the whole image.
+// OpenCV runs this filter on one thread; bands of rows run on its pool instead, with the pixels
+// of one call over the whole image (row_bands.h).
 cv::Mat3f SmoothStickyColour(const cv::Mat3f& colour) {
   const cv::Mat1f kernel = (cv::Mat1f(1, 3) << 0.25f, 0.5f, 0.25f);
-  cv::Mat3f smoothed(colour.size());
-  constexpr int kBandRows = 64;
-  const int bands = (colour.rows + kBandRows - 1) / kBandRows;
-  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
-    const cv::Range rows(range.start * kBandRows, std::min(colour.rows, range.end * kBandRows));
-    cv::Mat band = smoothed.rowRange(rows);
-    cv::sepFilter2D(colour.rowRange(rows), band, CV_32F, kernel, kernel, cv::Point(-1, -1), 0.0,
-                    cv::BORDER_REFLECT);
-  });
-  return smoothed;
+  return SepFilterInRowBands(colour, kernel, kernel);
 }
 
 Status ValidateSuperpixelInput(const cv::Mat3b& bgr, const cv::Mat1f& edge,

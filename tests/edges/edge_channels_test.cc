@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace tod {
 namespace {
@@ -124,6 +125,24 @@ TEST(EdgeChannels, OneThreadAndSeveralGiveTheSamePlanes) {
     EXPECT_EQ(cv::norm(one.planes[p], three.planes[p], cv::NORM_INF), 0.0) << "plane " << p;
   EXPECT_EQ(cv::norm(gradient_one.magnitude, gradient_three.magnitude, cv::NORM_INF), 0.0);
   EXPECT_EQ(cv::norm(gradient_one.orientation, gradient_three.orientation, cv::NORM_INF), 0.0);
+}
+
+// BgrToLuv runs in bands of rows; its reference is the conversion of the whole image at once.
+TEST(BgrToLuv, BandsGiveThePixelsOfOneWholeImageConversion) {
+  cv::Mat3b image(150, 77);
+  cv::RNG rng(5);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat3f unit;
+  image.convertTo(unit, CV_32F, 1.0 / 255.0);
+  cv::Mat3f reference;
+  cv::cvtColor(unit, reference, cv::COLOR_BGR2Luv);
+  reference *= 0.01f;
+  const int threads_before = cv::getNumThreads();
+  for (const int threads : {1, 3}) {
+    cv::setNumThreads(threads);
+    EXPECT_EQ(cv::norm(BgrToLuv(image), reference, cv::NORM_INF), 0.0) << threads << " threads";
+  }
+  cv::setNumThreads(threads_before);
 }
 
 TEST(EdgeChannels, EmptyImageGivesNoPlanes) {
