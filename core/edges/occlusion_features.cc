@@ -9,6 +9,8 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/base/row_bands.h"
+
 namespace tod {
 namespace {
 
@@ -48,21 +50,46 @@ void TextureRow(const float* __restrict gx, const float* __restrict gy, int cols
   }
 }
 
-std::vector<RegionStats> ComputeRegionStats(const cv::Mat3b& image, const cv::Mat1i& labels,
-                                            int count) {
+// The image as the regions' appearance reads it: LUV and HSV bytes and the Sobel derivatives.
+struct AppearanceImages {
   cv::Mat3b luv;
-  cv::Mat3b hsv;
-  cv::cvtColor(image, luv, cv::COLOR_BGR2Luv);
-  cv::cvtColor(image, hsv, cv::COLOR_BGR2HSV);  // 8-bit: H in [0,180), S and V in [0,256)
-  cv::Mat1b gray;
-  cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  cv::Mat3b hsv;  // 8-bit: H in [0,180), S and V in [0,256)
+  cv::Mat gx16;
+  cv::Mat gy16;
+};
+
+// The colour conversions are per pixel, so they run in bands of rows on OpenCV's pool with the
+// pixels of whole-image calls (row_bands.h). They run before the region statistics and the
+// boundary scan, which then run side by side: inside that pair, OpenCV's own splitting of
+// cv::cvtColor ran on one thread.
+AppearanceImages ConvertForAppearance(const cv::Mat3b& image) {
+  AppearanceImages out;
+  out.luv.create(image.size());
+  out.hsv.create(image.size());
+  cv::Mat1b gray(image.size());
+  ForEachRowBand(image.rows, [&](const cv::Range& rows) {
+    cv::Mat luv_band = out.luv.rowRange(rows);
+    cv::Mat hsv_band = out.hsv.rowRange(rows);
+    cv::Mat gray_band = gray.rowRange(rows);
+    const cv::Mat3b image_band = image.rowRange(rows);
+    cv::cvtColor(image_band, luv_band, cv::COLOR_BGR2Luv);
+    cv::cvtColor(image_band, hsv_band, cv::COLOR_BGR2HSV);
+    cv::cvtColor(image_band, gray_band, cv::COLOR_BGR2GRAY);
+  });
   // The 3x3 Sobel derivatives of an 8-bit image are integers in [-1020, 1020]: cv::Sobel into
   // CV_32F and cv::spatialGradient into CV_16S compute the same integers (same kernels, same
   // BORDER_DEFAULT border), and int16 -> float is exact. spatialGradient does both derivatives
   // in one pass over the image instead of two separable filters each.
-  cv::Mat gx16;
-  cv::Mat gy16;
-  cv::spatialGradient(gray, gx16, gy16, 3, cv::BORDER_DEFAULT);
+  cv::spatialGradient(gray, out.gx16, out.gy16, 3, cv::BORDER_DEFAULT);
+  return out;
+}
+
+std::vector<RegionStats> ComputeRegionStats(const AppearanceImages& appearance,
+                                            const cv::Mat1i& labels, int count) {
+  const cv::Mat3b& luv = appearance.luv;
+  const cv::Mat3b& hsv = appearance.hsv;
+  const cv::Mat& gx16 = appearance.gx16;
+  const cv::Mat& gy16 = appearance.gy16;
 
   // Integer sums per region while scanning (see the loop below); RegionStats at the end.
   struct Sums {
@@ -369,12 +396,13 @@ SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& 
   // The regions' appearance and the boundary scan read the same labels and nothing of each
   // other: on OpenCV's pool they run side by side (one after the other on one thread), each
   // computing exactly what it computes alone.
+  const AppearanceImages appearance = ConvertForAppearance(image);
   std::vector<RegionStats> regions;
   std::vector<cv::Point> boundary_points;
   cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& tasks) {
     for (int task = tasks.start; task < tasks.end; ++task) {
       if (task == 0)
-        regions = ComputeRegionStats(image, superpixels.labels, superpixels.count);
+        regions = ComputeRegionStats(appearance, superpixels.labels, superpixels.count);
       else
         boundary_points = ScanBoundaries(superpixels, out);
     }
