@@ -8,6 +8,12 @@ namespace tod {
 
 void ForEachRowBand(int rows, const std::function<void(const cv::Range&)>& band) {
   if (rows <= 0) return;
+  // One thread gains nothing from bands and would pay each band's set-up: the whole image at
+  // once, which is also the reference the bands are held to.
+  if (cv::getNumThreads() <= 1) {
+    band(cv::Range(0, rows));
+    return;
+  }
   const int bands = (rows + kRowsPerBand - 1) / kRowsPerBand;
   cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
     for (int b = range.start; b < range.end; ++b) {

@@ -14,7 +14,8 @@ namespace tod {
 inline constexpr int kRowsPerBand = 64;
 
 // Runs band(rows) for consecutive ranges of at most kRowsPerBand rows covering [0, rows), on
-// OpenCV's pool. Bands must write only their own rows.
+// OpenCV's pool; with one thread (cv::getNumThreads() == 1), once over all rows. Bands must write
+// only their own rows.
 void ForEachRowBand(int rows, const std::function<void(const cv::Range&)>& band);
 
 // cv::sepFilter2D(src, dst, src.depth(), kernel_x, kernel_y, anchor centred, delta 0,

@@ -29,6 +29,14 @@ cv::Mat1f Triangle(int radius) {
   return kernel / cv::sum(kernel)[0];
 }
 
+TEST(ForEachRowBand, OneThreadVisitsAllRowsAtOnce) {
+  const PoolWidth pool(1);
+  std::vector<cv::Range> calls;
+  ForEachRowBand(3 * kRowsPerBand + 1, [&](const cv::Range& rows) { calls.push_back(rows); });
+  ASSERT_EQ(calls.size(), 1u);
+  EXPECT_EQ(calls[0], cv::Range(0, 3 * kRowsPerBand + 1));
+}
+
 TEST(ForEachRowBand, VisitsEveryRowOnceInBandsOfAtMostTheBandHeight) {
   const PoolWidth pool(3);
   for (const int rows : {0, 1, kRowsPerBand - 1, kRowsPerBand, kRowsPerBand + 1, 1000}) {
