@@ -69,6 +69,9 @@ fi
 # libFuzzer's own flags: a 2 GB RSS limit (a loader must refuse a huge claim, not allocate it),
 # 25 s per input, no leak checking per input (the gRPC library keeps process-wide state).
 common=(-rss_limit_mb=2048 -timeout=25 -print_final_stats=1 -detect_leaks=0)
+# The leak check at exit still runs; leaks inside libraries that are not ours are suppressed
+# there, each with its reason in the file.
+export LSAN_OPTIONS="suppressions=$ROOT/tests/fuzz/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 if [[ -n $runs ]]; then
   limit=(-runs="$runs" -max_total_time="$max_time")
 else
