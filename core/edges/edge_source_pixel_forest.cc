@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/base/row_bands.h"
 #include "core/edges/edge_channels.h"
 #include "core/edges/edge_labels.h"
 #include "core/edges/edge_pixel_features.h"
@@ -176,8 +177,13 @@ cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr, const EdgeScreening
   cv::Mat1f padded_map;
   cv::resize(cell_map, padded_map, cv::Size(2 * cell_map.cols, 2 * cell_map.rows), 0, 0,
              cv::INTER_LINEAR);
-  cv::Mat1f edge = padded_map(cv::Rect(0, 0, bgr.cols, bgr.rows)).clone();
-  cv::min(cv::max(edge, 0.f), 1.f, edge);
+  // Clamped to [0, 1] per pixel, in bands of rows (row_bands.h).
+  const cv::Mat1f unclamped = padded_map(cv::Rect(0, 0, bgr.cols, bgr.rows));
+  cv::Mat1f edge(bgr.size());
+  ForEachRowBand(edge.rows, [&](const cv::Range& rows) {
+    cv::Mat band = edge.rowRange(rows);
+    cv::min(cv::max(unclamped.rowRange(rows), 0.f), 1.f, band);
+  });
   return edge;
 }
 

@@ -68,8 +68,11 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
   const int height = bgr.rows;
   const StickyWeights weights = StickyWeightsFor(params.k, params.alpha, params.beta);
 
-  cv::Mat3f colour;
-  bgr.convertTo(colour, CV_32F, 1.0 / 255.0);
+  cv::Mat3f colour(bgr.size());
+  ForEachRowBand(height, [&](const cv::Range& rows) {
+    cv::Mat band = colour.rowRange(rows);
+    bgr.rowRange(rows).convertTo(band, CV_32F, 1.0 / 255.0);
+  });
   const cv::Mat1f edge_full = edge.isContinuous() ? edge : edge.clone();
 
   // Half resolution on the even-sized crop: 2·nIter sweeps, size weight ×¼ and position ×4 so
@@ -92,14 +95,16 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
                        half_labels, params.strip_rows / 2);
     // Nearest ×2 upsampling; odd last row/column replicate their neighbour.
     flat.resize(static_cast<size_t>(width) * height);
-    for (int y = 0; y < height; ++y) {
-      const int hy = std::min(y / 2, half_h - 1);
-      for (int x = 0; x < width; ++x) {
-        const int hx = std::min(x / 2, half_w - 1);
-        flat[static_cast<size_t>(y) * width + x] =
-            half_labels[static_cast<size_t>(hy) * half_w + hx];
+    ForEachRowBand(height, [&](const cv::Range& rows) {
+      for (int y = rows.start; y < rows.end; ++y) {
+        const int hy = std::min(y / 2, half_h - 1);
+        for (int x = 0; x < width; ++x) {
+          const int hx = std::min(x / 2, half_w - 1);
+          flat[static_cast<size_t>(y) * width + x] =
+              half_labels[static_cast<size_t>(hy) * half_w + hx];
+        }
       }
-    }
+    });
   } else {
     flat = OneLabelPerPixel(width, height);  // a 1-pixel-thin crop has no half resolution
   }
