@@ -1,7 +1,6 @@
 #include "core/edges/sticky_superpixels.h"
 
 #include <algorithm>
-#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <utility>
