@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace tod {
 namespace {
 
@@ -75,6 +77,20 @@ TEST(MultilayerRegions, JsonRoundTripAndValidation) {
   bad["layers"][0] = {0, 0, 5000, 10};
   EXPECT_FALSE(MultilayerRegions::FromJson(bad).ok());
   EXPECT_FALSE(MultilayerRegions::FromJson(nlohmann::json::object()).ok());
+  // A far side past INT_MAX (fuzz_manifest found y + h overflowing): refused, no overflow.
+  bad = laf.ToJson();
+  bad["layers"][3] = {904, 373, 341, std::numeric_limits<int>::max()};
+  EXPECT_FALSE(MultilayerRegions::FromJson(bad).ok());
+}
+
+// Boxes reaching past INT_MAX intersect without overflow; the result fits in ints.
+TEST(BoxIntersect, FarSidesPastIntMax) {
+  constexpr int kMax = std::numeric_limits<int>::max();
+  EXPECT_EQ(Intersect(Box{373, 373, kMax, kMax}, Box{0, 0, 2048, 1024}),
+            (Box{373, 373, 1675, 651}));
+  EXPECT_EQ(Intersect(Box{10, 10, kMax, kMax}, Box{20, 20, kMax, kMax}),
+            (Box{20, 20, kMax - 10, kMax - 10}));
+  EXPECT_TRUE(Intersect(Box{kMax, 0, kMax, 5}, Box{0, 0, 10, 5}).empty());
 }
 
 TEST(MultilayerRegions, ScaledToHalfSize) {
