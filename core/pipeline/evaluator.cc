@@ -4,12 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
-#include <opencv2/ximgproc/edgeboxes.hpp>
 #include <sstream>
 
 #include "core/metrics/instance_recall.h"
 #include "core/pipeline/dataset_factory.h"
-#include "core/pipeline/edge_boxes_baseline.h"
+#include "core/pipeline/frame_evaluation.h"
 #include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/parallel.h"
 
@@ -18,13 +17,6 @@ namespace {
 
 constexpr int kMaxProposals = 1000;
 const std::vector<int> kTableN = {200, 400, 600, 800, 1000};
-
-std::vector<Box> BoxesOf(const std::vector<ScoredBox>& boxes) {
-  std::vector<Box> out;
-  out.reserve(boxes.size());
-  for (const auto& b : boxes) out.push_back(b.box);
-  return out;
-}
 
 VariantCurves Curves(const RecallAccumulator& acc) {
   VariantCurves c;
@@ -62,178 +54,106 @@ nlohmann::json NumberOrNull(double v) {
 
 }  // namespace
 
+namespace {
+
+// The split's running totals: recall per variant, pixel counts per map variant, the reported
+// obstacles and the stage times. The caller serialises Add().
+class EvalTotals {
+ public:
+  explicit EvalTotals(bool calibrated_map) : map_variants_(RegressionVariants()) {
+    for (const auto& v : ProposalVariants()) recall_.emplace(v, RecallAccumulator(kMaxProposals));
+    for (const auto& v : RegressionVariants()) recall_.emplace(v, RecallAccumulator(kMaxProposals));
+    if (calibrated_map) map_variants_.push_back(kCalibratedMapVariant);
+    for (const auto& v : map_variants_) {
+      roc_.emplace(v, PixelRocAccumulator());
+      histograms_.emplace(v, PixelHistogramAccumulator());
+    }
+  }
+
+  Status Add(const FrameEvaluation& frame, const Sample& s) {
+    // A map that does not match its frame's masks is this frame's error, not a silent gap in
+    // the pooled pixel counts. First, so that a failing frame is counted nowhere (every map has
+    // the frame's size, so the first variant decides).
+    for (const auto& [variant, map] : frame.maps) {
+      Status st = roc_.at(variant).Add(map, s.obstacle, s.road);
+      if (st.ok()) st = histograms_.at(variant).Add(map, s.obstacle, s.road);
+      if (!st.ok()) return st.WithContext(variant);
+    }
+    reported_.false_alarms += frame.false_alarms;
+    reported_.instances_found += frame.instances_found;
+    if (s.instances.empty()) {
+      ++reported_.obstacle_free_frames;
+      reported_.false_alarms_on_obstacle_free += frame.false_alarms;
+    }
+    (s.free_space == FreeSpace::kRoadLabel ? road_labelled_ : not_obstacle_) = true;
+    std::vector<Box> gt;
+    for (const auto& inst : s.instances) gt.push_back(inst.box);
+    for (const auto& [variant, boxes] : frame.ranked) recall_.at(variant).Add(boxes, gt);
+    for (const auto& [stage, ms] : frame.stage_times) {
+      if (!stage_ms_.count(stage)) stage_order_.push_back(stage);
+      stage_ms_[stage].push_back(ms);
+    }
+    stage_ms_["total"].push_back(frame.total_ms);
+    return Status::Ok();
+  }
+
+  void Fill(EvalReport& report) const {
+    report.instances = recall_.at("EB").instances();
+    report.reported = reported_;
+    report.free_space = road_labelled_ && not_obstacle_
+                            ? "mixed: the road label where the frame has one, else every non-void "
+                              "non-obstacle pixel"
+                        : not_obstacle_
+                            ? "every non-void pixel that is not an obstacle (no road label)"
+                            : "the road label (free space)";
+    for (const auto& v : ProposalVariants()) report.proposals[v] = Curves(recall_.at(v));
+    for (const auto& v : RegressionVariants()) report.regression[v] = Curves(recall_.at(v));
+    for (const auto& v : map_variants_) {
+      report.roc[v] = roc_.at(v).Curve();
+      for (double fpr : TableFprs()) report.tpr_at_fpr[v][fpr] = TprAtFpr(report.roc[v], fpr);
+      const PixelHistogramAccumulator& histograms = histograms_.at(v);
+      report.average_precision[v] = histograms.Ap();
+      report.fpr_at_tpr95[v] = histograms.FprAtTpr(0.95);
+      report.precision_recall[v] = histograms.PrCurve();
+    }
+    std::vector<std::string> stages = stage_order_;
+    stages.push_back("total");
+    for (const auto& stage : stages) {
+      const auto times = stage_ms_.find(stage);
+      report.stage_median_ms.emplace_back(stage,
+                                          times == stage_ms_.end() ? 0.0 : Median(times->second));
+    }
+  }
+
+ private:
+  std::vector<std::string> map_variants_;
+  std::map<std::string, RecallAccumulator> recall_;
+  std::map<std::string, PixelRocAccumulator> roc_;
+  std::map<std::string, PixelHistogramAccumulator> histograms_;  // AP, FPR95
+  ReportedObstacleCounts reported_;
+  bool road_labelled_ = false, not_obstacle_ = false;
+  std::vector<std::string> stage_order_;
+  std::map<std::string, std::vector<double>> stage_ms_;
+};
+
+}  // namespace
+
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options) {
   auto selection = SelectFrames(
       {options.data_root, options.split, options.format, options.split_file, options.max_frames});
   if (!selection.ok()) return selection.status();
   const Dataset& dataset = *selection->dataset;
   const int n = static_cast<int>(selection->frames.size());
-
-  std::map<std::string, RecallAccumulator> recall;
-  for (const auto& v : ProposalVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
-  for (const auto& v : RegressionVariants()) recall.emplace(v, RecallAccumulator(kMaxProposals));
-  const bool calibrated_map = bundle.params.obstacle_calibration.fitted;
-  std::vector<std::string> map_variants = RegressionVariants();
-  if (calibrated_map) map_variants.push_back(kCalibratedMapVariant);
-  std::map<std::string, PixelRocAccumulator> roc;
-  std::map<std::string, PixelHistogramAccumulator> served_map_histograms;  // AP, FPR95
-  for (const auto& v : map_variants) {
-    roc.emplace(v, PixelRocAccumulator());
-    served_map_histograms.emplace(v, PixelHistogramAccumulator());
-  }
-  std::map<std::string, std::vector<double>> stage_ms;
-  ReportedObstacleCounts alarms;
-  bool road_labelled = false, not_obstacle = false;
-  std::vector<std::string> stage_order;
+  EvalTotals totals(bundle.params.obstacle_calibration.fitted);
   std::mutex mutex;
   int done = 0;
-
   const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
-    auto loaded = dataset.Load(selection->frames[i]);
+    const auto loaded = dataset.Load(selection->frames[i]);
     if (!loaded.ok()) return loaded.status();
-    const Sample& s = *loaded;
-    const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
-    const int layers = geo.regions.num_layers();
-
-    // Proposal-only baselines on plain (not obstacle-aware) edges. OLP@1 must not run the
-    // occlusion classifier, which learned its features on enhanced edges Ê: it scores each
-    // superpixel boundary by its mean plain E instead (the untrained boundary strength of §3.4),
-    // so OLP@1 -> OAOCC+OLP@1 measures enhancement plus the trained obstacle-aware classifier.
-    const OcclusionClassifier untrained_boundaries;
-    PipelineParams plain_params = bundle.params;
-    plain_params.prior_correction.occlusion_odds = 1.0;  // mean E is no classifier probability
-    const Result<OcclusionEdges> plain_computed =
-        ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &untrained_boundaries,
-                              OcclusionFeatureOptions{}, plain_params, /*enhance=*/false);
-    if (!plain_computed.ok()) return plain_computed.status();
-    const OcclusionEdges& plain = *plain_computed;
-    const std::vector<Box> eb = EdgeBoxesBaseline(plain.base_edge, plain.r1, kMaxProposals);
-    const ProposalSet olp1 = ProposeBoxes(
-        plain, geo.regions, bundle.params.boxes,
-        {1, false, bundle.params.size_filter, bundle.params.region_merge_iou}, geo.size_filter);
-
-    // The detector's own path (timed): enhanced edges, BP = OAOCC+OLP@4+MS, regression, map.
-    StageTimer timer;
-    const Result<OcclusionEdges> computed =
-        ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion,
-                              OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows),
-                              bundle.params, /*enhance=*/true, &timer);
-    if (!computed.ok()) return computed.status();
-    const OcclusionEdges& oaocc = *computed;
-    const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
-    std::vector<RegionProposals> ms_regions;
-    for (int k = 0; k < layers; ++k)
-      ms_regions.push_back(
-          ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k, true, filter));
-    ProposalSet bp = MergeRegionBoxes(ms_regions, bundle.params.region_merge_iou);
-    timer.Mark("proposals");
-    // R1's stride factor is 1 with and without MS, so its boxes serve OAOCC+OLP@1 and OP too;
-    // only R2..RK are scored again without MS.
-    const std::vector<Box> oaocc1 = BoxesOf(ms_regions.front().boxes);
-    std::vector<RegionProposals> plain_regions = {ms_regions.front()};
-    for (int k = 1; k < layers; ++k)
-      plain_regions.push_back(
-          ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k, false, filter));
-    const std::vector<Box> bp_boxes = RankedOnCommonScale(bp);
-    const RegressedProposals bp_reg =
-        RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(bp), &timer);
-    const std::vector<float> fused = FuseScores(bp_reg.ordr, bp_reg.obdr, bundle.params.fusion);
-    std::vector<ScoredBox> bp_fusion(fused.size()), bp_ordr(fused.size());
-    for (std::size_t j = 0; j < fused.size(); ++j) {
-      bp_fusion[j] = {bp_reg.proposals.boxes[j].box, fused[j]};
-      bp_ordr[j] = {bp_reg.proposals.boxes[j].box, bp_reg.ordr[j]};
-    }
-    const MapSuperpixels superpixels{oaocc.superpixels, oaocc.r1};
-    const MapAccumulation fusion_boxes = AccumulatedBoxes(bp_fusion, bundle.params.probability_map);
-    Result<cv::Mat1f> fusion_made =
-        PaintProbabilityMap(fusion_boxes, s.image.size(),
-                            bundle.params.probability_map.superpixel_shares, &superpixels);
-    if (!fusion_made.ok()) return fusion_made.status();
-    const cv::Mat1f map_fusion = std::move(fusion_made).value();
-    timer.Mark("probability_map");
-
-    ProposalSet op = MergeRegionBoxes(plain_regions, bundle.params.region_merge_iou);
-    const std::vector<Box> op_boxes = RankedOnCommonScale(op);
-    const RegressedProposals op_reg =
-        RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(op));
-    std::vector<ScoredBox> op_ordr(op_reg.ordr.size());
-    for (std::size_t j = 0; j < op_ordr.size(); ++j)
-      op_ordr[j] = {op_reg.proposals.boxes[j].box, op_reg.ordr[j]};
-    Result<cv::Mat1f> bp_ordr_made = AccumulateProbabilityMap(
-        bp_ordr, s.image.size(), bundle.params.probability_map, &superpixels);
-    Result<cv::Mat1f> op_ordr_made = AccumulateProbabilityMap(
-        op_ordr, s.image.size(), bundle.params.probability_map, &superpixels);
-    if (!bp_ordr_made.ok()) return bp_ordr_made.status();
-    if (!op_ordr_made.ok()) return op_ordr_made.status();
-    const cv::Mat1f map_bp_ordr = std::move(bp_ordr_made).value();
-    const cv::Mat1f map_op_ordr = std::move(op_ordr_made).value();
-    const float min_score = bundle.params.probability_map.min_score;
-    cv::Mat1f map_calibrated;
-    if (calibrated_map) {
-      Result<cv::Mat1f> made = ServedProbabilityMap(bp_fusion, fusion_boxes, s.image.size(), oaocc,
-                                                    bundle.params, MapKind::kCalibrated);
-      if (!made.ok()) return made.status();
-      map_calibrated = std::move(*made);
-    }
-
-    // Reported obstacles at the detector's defaults (calibrated score >= 0.5), from the map the
-    // detector takes them from.
-    Result<cv::Mat1f> obstacle_made = ObstacleComponentsMap(
-        fusion_boxes, s.image.size(), bundle.params, MapKind::kNormalized, map_fusion);
-    if (!obstacle_made.ok()) return obstacle_made.status();
-    const cv::Mat1f obstacle_map = std::move(obstacle_made).value();
-    const std::vector<DetectedObstacle> reported =
-        ScoreObstacles(obstacle_map, fusion_boxes.boxes, bundle.params, DetectOptions{});
-    int false_alarms = 0;
-    for (const DetectedObstacle& o : reported)
-      false_alarms += cv::countNonZero(s.obstacle(o.box.rect())) == 0;
-    int found = 0;
-    for (const ObstacleInstance& inst : s.instances)
-      for (const DetectedObstacle& o : reported)
-        if (!Intersect(o.box, inst.box).empty()) {
-          ++found;
-          break;
-        }
-
-    std::vector<Box> gt;
-    for (const auto& inst : s.instances) gt.push_back(inst.box);
+    const Result<FrameEvaluation> frame = EvaluateFrame(bundle, *loaded);
+    if (!frame.ok()) return frame.status();
     std::lock_guard lock(mutex);
-    // A map that does not match its frame's masks is this frame's error, not a silent gap in
-    // the pooled pixel counts. First, so that a failing frame is counted nowhere (every map has
-    // the frame's size, so the first variant decides).
-    const auto add_pixels = [&](const std::string& variant, const cv::Mat1f& map) {
-      if (Status st = roc.at(variant).Add(map, s.obstacle, s.road); !st.ok()) return st;
-      return served_map_histograms.at(variant).Add(map, s.obstacle, s.road);
-    };
-    for (const auto& [variant, map] :
-         {std::pair{"OP+ORDR@4", &map_op_ordr}, std::pair{"BP+ORDR@4", &map_bp_ordr},
-          std::pair{"BP+Fusion@4", &map_fusion}}) {
-      if (Status st = add_pixels(variant, *map); !st.ok()) return st.WithContext(variant);
-    }
-    if (calibrated_map) {
-      if (Status st = add_pixels(kCalibratedMapVariant, map_calibrated); !st.ok())
-        return st.WithContext(kCalibratedMapVariant);
-    }
-    alarms.false_alarms += false_alarms;
-    (s.free_space == FreeSpace::kRoadLabel ? road_labelled : not_obstacle) = true;
-    alarms.instances_found += found;
-    if (s.instances.empty()) {
-      ++alarms.obstacle_free_frames;
-      alarms.false_alarms_on_obstacle_free += false_alarms;
-    }
-    recall.at("EB").Add(eb, gt);
-    recall.at("OLP@1").Add(BoxesOf(olp1.boxes), gt);
-    recall.at("OAOCC+OLP@1").Add(oaocc1, gt);
-    recall.at("OAOCC+OLP@4").Add(op_boxes, gt);
-    recall.at("OAOCC+OLP@4+MS").Add(bp_boxes, gt);
-    recall.at("OP+ORDR@4").Add(BoxesOf(RankedAboveThreshold(op_ordr, min_score)), gt);
-    recall.at("BP+ORDR@4").Add(BoxesOf(RankedAboveThreshold(bp_ordr, min_score)), gt);
-    recall.at("BP+Fusion@4").Add(BoxesOf(RankedAboveThreshold(bp_fusion, min_score)), gt);
-    for (const auto& [stage, ms] : timer.times()) {
-      if (!stage_ms.count(stage)) stage_order.push_back(stage);
-      stage_ms[stage].push_back(ms);
-    }
-    stage_ms["total"].push_back(timer.total_ms());
+    if (Status st = totals.Add(*frame, *loaded); !st.ok()) return st;
     ++done;
     if (options.progress && (done % 10 == 0 || done == n))
       options.progress("evaluated " + std::to_string(done) + "/" + std::to_string(n) + " frames");
@@ -245,31 +165,11 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
       &report.skipped);
   if (!bad.ok()) return bad;
   report.frames = n - static_cast<int>(report.skipped.size());
-  report.instances = recall.at("EB").instances();
-  report.reported = alarms;
   report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;
   report.map_superpixel_shares = bundle.params.probability_map.superpixel_shares;
   report.proposal_features = bundle.ordr.num_features();
   report.proposal_feature_set = ProposalFeatureSet(bundle.params);
-  report.free_space = road_labelled && not_obstacle
-                          ? "mixed: the road label where the frame has one, else every non-void "
-                            "non-obstacle pixel"
-                      : not_obstacle
-                          ? "every non-void pixel that is not an obstacle (no road label)"
-                          : "the road label (free space)";
-  for (const auto& v : ProposalVariants()) report.proposals[v] = Curves(recall.at(v));
-  for (const auto& v : RegressionVariants()) report.regression[v] = Curves(recall.at(v));
-  for (const auto& v : map_variants) {
-    report.roc[v] = roc.at(v).Curve();
-    for (double fpr : TableFprs()) report.tpr_at_fpr[v][fpr] = TprAtFpr(report.roc[v], fpr);
-    const PixelHistogramAccumulator& histograms = served_map_histograms.at(v);
-    report.average_precision[v] = histograms.Ap();
-    report.fpr_at_tpr95[v] = histograms.FprAtTpr(0.95);
-    report.precision_recall[v] = histograms.PrCurve();
-  }
-  stage_order.push_back("total");
-  for (const auto& stage : stage_order)
-    report.stage_median_ms.emplace_back(stage, Median(stage_ms[stage]));
+  totals.Fill(report);
   return report;
 }
 

@@ -823,6 +823,62 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
   return Status::Ok();
 }
 
+// The manifest's record of one regressor ("ordr" or "obdr"): what it learned from and how.
+nlohmann::json RegressorPartRecord(const std::string& name, const TrainOptions& options,
+                                   const Regressors& regressors, int num_features,
+                                   const ClassifierFolds& folds) {
+  const bool ordr = name == "ordr";
+  const ForestParams forest = RegressorForest(options);
+  return {{"learned", true},
+          {"trained", true},
+          {"samples", ordr ? regressors.ordr_samples : regressors.obdr_samples},
+          {"trees", forest.num_trees},
+          {"mtry", forest.max_features},
+          {"min_leaf", forest.min_leaf_size},
+          {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"},
+          {"negatives_per_range",
+           ordr ? options.selection.ordr_negatives : options.selection.obdr_negatives},
+          {"negative_bags", options.selection.negative_bags},
+          {"hard_fraction", options.selection.hard_fraction},
+          {"pasted_copies", options.pasted_copies},
+          {"features", num_features},
+          {"maps", folds.enabled ? "out_of_fold" : "in_sample"},
+          {"fold_layout", FoldLayoutName(options.fold_layout)}};
+}
+
+// The manifest's "training" record: the data, the frames and samples, every part's record and
+// the run's seconds and peak memory.
+nlohmann::json TrainingRecord(const TrainingRun& run, const Survey& survey,
+                              const RegressorSamples& samples, const Regressors& regressors,
+                              const nlohmann::json& parts, const nlohmann::json& seconds) {
+  const TrainOptions& options = run.options();
+  const int n = static_cast<int>(survey.usable.size());
+  const ForestParams forest = RegressorForest(options);
+  nlohmann::json data = nlohmann::json::array({options.data_root});
+  for (const std::string& root : options.more_data) data.push_back(root);
+  return {{"data", options.more_data.empty() ? nlohmann::json(options.data_root) : data},
+          {"format", run.format()},
+          {"data_terms", options.data_terms},
+          {"split", options.split},
+          {"frames", n},
+          {"skipped_frames", SkippedFramesToJson(survey.skipped)},
+          {"frame_size", {survey.width, survey.height}},
+          {"obstacles", survey.footprints.size()},
+          {"regions_from", options.regions},
+          {"seed", options.seed},
+          {"classifier_frames", ClassifierFrames(run, survey).size()},
+          {"mean_proposals_per_frame", static_cast<double>(samples.proposals) / n},
+          {"ordr_samples", regressors.ordr_samples},
+          {"obdr_samples", regressors.obdr_samples},
+          {"parts", parts},
+          {"regressor",
+           {{"trees", forest.num_trees},
+            {"mtry", forest.max_features},
+            {"min_leaf", forest.min_leaf_size}}},
+          {"peak_rss_mb", PeakRssMb()},
+          {"seconds", seconds}};
+}
+
 }  // namespace
 
 cv::Mat1i LabelMap(const Sample& sample) {
@@ -878,25 +934,8 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
   bundle.obdr = std::move(trained->regressors.obdr);
   const RegressorSamples& samples = trained->samples;
   const Regressors& regressors = trained->regressors;  // its sample counts
-  const ForestParams forest = RegressorForest(options);
   for (const char* name : {"ordr", "obdr"})
-    parts[name] = {
-        {"learned", true},
-        {"trained", true},
-        {"samples",
-         std::string(name) == "ordr" ? regressors.ordr_samples : regressors.obdr_samples},
-        {"trees", forest.num_trees},
-        {"mtry", forest.max_features},
-        {"min_leaf", forest.min_leaf_size},
-        {"hard_negatives", options.mine_hard_negatives ? "mined" : "objectness"},
-        {"negatives_per_range", std::string(name) == "ordr" ? options.selection.ordr_negatives
-                                                            : options.selection.obdr_negatives},
-        {"negative_bags", options.selection.negative_bags},
-        {"hard_fraction", options.selection.hard_fraction},
-        {"pasted_copies", options.pasted_copies},
-        {"features", bundle.ordr.num_features()},
-        {"maps", folds.enabled ? "out_of_fold" : "in_sample"},
-        {"fold_layout", FoldLayoutName(options.fold_layout)}};
+    parts[name] = RegressorPartRecord(name, options, regressors, bundle.ordr.num_features(), folds);
 
   run.StartStep();
   run.Say("calibrating obstacle scores and fitting the map's isolation (2-fold)");
@@ -904,32 +943,9 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
     return st;
   run.EndStep("calibration");
 
-  const int n = static_cast<int>(survey->usable.size());
   nlohmann::json seconds = run.seconds();
   seconds["total"] = SecondsSince(run.started());
-  nlohmann::json data = nlohmann::json::array({options.data_root});
-  for (const std::string& root : options.more_data) data.push_back(root);
-  bundle.training = {{"data", options.more_data.empty() ? nlohmann::json(options.data_root) : data},
-                     {"format", run.format()},
-                     {"data_terms", options.data_terms},
-                     {"split", options.split},
-                     {"frames", n},
-                     {"skipped_frames", SkippedFramesToJson(survey->skipped)},
-                     {"frame_size", {survey->width, survey->height}},
-                     {"obstacles", survey->footprints.size()},
-                     {"regions_from", options.regions},
-                     {"seed", options.seed},
-                     {"classifier_frames", ClassifierFrames(run, *survey).size()},
-                     {"mean_proposals_per_frame", static_cast<double>(samples.proposals) / n},
-                     {"ordr_samples", regressors.ordr_samples},
-                     {"obdr_samples", regressors.obdr_samples},
-                     {"parts", parts},
-                     {"regressor",
-                      {{"trees", forest.num_trees},
-                       {"mtry", forest.max_features},
-                       {"min_leaf", forest.min_leaf_size}}},
-                     {"peak_rss_mb", PeakRssMb()},
-                     {"seconds", seconds}};
+  bundle.training = TrainingRecord(run, *survey, samples, regressors, parts, seconds);
   bundle.version = "tod-" + NowIso8601().substr(0, 10) + "-seed" + std::to_string(options.seed);
   run.Say("trained in " + std::to_string(static_cast<int>(seconds["total"].get<double>())) + " s");
   return bundle;
