@@ -12,7 +12,9 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
+#include <variant>
 
 #include "server/core/inference_engine.h"
 #include "server/core/model_holder.h"
@@ -109,164 +111,135 @@ std::chrono::milliseconds Within(std::chrono::milliseconds budget,
   return std::clamp(left, std::chrono::milliseconds(0), budget);
 }
 
-}  // namespace
-
-void BlockServerSignals() {
-  const sigset_t signals = ServerSignals();
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+// Refuses to start: logs `event` with the error and says it on stderr; returns the exit code.
+int Refuse(const char* event, const std::string& log_error, const std::string& message,
+           int exit_code) {
+  LogEvent(spdlog::level::err, event, {{"error", log_error}});
+  std::cerr << "tod_server: " << message << "\n";
+  return exit_code;
 }
 
-int RunServer(const ServerConfig& config) {
-  BlockServerSignals();  // before any thread starts, so all of them inherit the mask
-  LogEvent(spdlog::level::info, "starting", ServerConfigToJson(config));
-
-  // TLS files and tokens are checked before anything listens: a typo must not start a server
-  // that is open (no tokens) or unreachable (no certificate).
+// TLS material and bearer tokens, both optional.
+struct Security {
   std::optional<TlsMaterial> tls;
+  std::shared_ptr<TokenAuthenticator> auth;
+};
+
+// TLS files and tokens are checked before anything listens: a typo must not start a server that
+// is open (no tokens) or unreachable (no certificate). On failure, the exit code (2).
+std::variant<Security, int> LoadSecurity(const ServerConfig& config) {
+  Security security;
   if (const TlsFiles files{config.tls_cert, config.tls_key, config.tls_client_ca};
       files.enabled()) {
     Result<TlsMaterial> loaded = LoadTlsMaterial(files);
     if (!loaded.ok()) {
-      LogEvent(spdlog::level::err, "tls refused", {{"error", loaded.status().message()}});
-      std::cerr << "tod_server: " << loaded.status().message() << "\n";
-      return 2;
+      const std::string& error = loaded.status().message();
+      return Refuse("tls refused", error, error, 2);
     }
-    tls = std::move(*loaded);
+    security.tls = std::move(*loaded);
   }
-  std::shared_ptr<TokenAuthenticator> auth;
   if (!config.auth_token_file.empty()) {
     Result<std::shared_ptr<TokenAuthenticator>> loaded =
         TokenAuthenticator::FromFile(config.auth_token_file);
     if (!loaded.ok()) {
-      LogEvent(spdlog::level::err, "auth tokens refused", {{"error", loaded.status().message()}});
-      std::cerr << "tod_server: " << loaded.status().message() << "\n";
-      return 2;
+      const std::string& error = loaded.status().message();
+      return Refuse("auth tokens refused", error, error, 2);
     }
-    auth = std::move(*loaded);
-    LogEvent(spdlog::level::info, "auth tokens loaded", {{"tokens", auth->token_count()}});
+    security.auth = std::move(*loaded);
+    LogEvent(spdlog::level::info, "auth tokens loaded", {{"tokens", security.auth->token_count()}});
   }
+  return security;
+}
 
-  ServerMetrics metrics;
-  ModelHolder models;
-  EngineConfig engine_config;
-  engine_config.workers = config.workers;
-  engine_config.threads_per_request = config.threads_per_request;
-  engine_config.frame_budget_ms = config.frame_budget_ms;
-  engine_config.queue_capacity = config.queue;
-  engine_config.limits.max_bytes = config.max_image_bytes;
-  engine_config.limits.max_pixels = config.max_image_pixels;
-  InferenceEngine engine(engine_config, models, &metrics);
-  engine.Start();
+EngineConfig EngineConfigFrom(const ServerConfig& config) {
+  EngineConfig engine;
+  engine.workers = config.workers;
+  engine.threads_per_request = config.threads_per_request;
+  engine.frame_budget_ms = config.frame_budget_ms;
+  engine.queue_capacity = config.queue;
+  engine.limits.max_bytes = config.max_image_bytes;
+  engine.limits.max_pixels = config.max_image_pixels;
+  return engine;
+}
 
-  // Listeners come up first and report not-ready until the model is loaded, so orchestrators
-  // can tell "starting" from "dead".
-  ObstacleDiscoveryService service(engine, models, metrics, auth);
+// The gRPC listener with health checking and reflection, reporting not-serving until the model is
+// loaded; *port receives the bound port. Null when it cannot listen.
+std::unique_ptr<grpc::Server> StartGrpc(const ServerConfig& config, const Security& security,
+                                        ObstacleDiscoveryService& service, int* port) {
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
-  int grpc_port = 0;
-  const std::string grpc_address = config.host + ":" + std::to_string(config.grpc_port);
-  builder.AddListeningPort(grpc_address,
-                           tls ? GrpcServerCredentials(*tls) : grpc::InsecureServerCredentials(),
-                           &grpc_port);
+  const std::string address = config.host + ":" + std::to_string(config.grpc_port);
+  builder.AddListeningPort(
+      address,
+      security.tls ? GrpcServerCredentials(*security.tls) : grpc::InsecureServerCredentials(),
+      port);
   builder.SetMaxReceiveMessageSize(static_cast<int>(config.max_image_bytes + kGrpcMessageSlack));
   builder.RegisterService(&service);
-  std::unique_ptr<grpc::Server> grpc_server = builder.BuildAndStart();
-  if (!grpc_server || grpc_port == 0) {
-    LogEvent(spdlog::level::err, "cannot listen for gRPC", {{"address", grpc_address}});
-    std::cerr << "tod_server: cannot listen for gRPC on " << grpc_address
-              << " (port in use or not permitted)\n";
-    return 1;
-  }
-  grpc::HealthCheckServiceInterface* health = grpc_server->GetHealthCheckService();
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  if (!server || *port == 0) return nullptr;
+  grpc::HealthCheckServiceInterface* health = server->GetHealthCheckService();
   // Register the service's own name too (grpc.health.v1 answers NOT_FOUND for unknown names);
-  // SetServingStatus(bool) below then switches "" and this name together.
+  // SetServingStatus(bool) then switches "" and this name together.
   health->SetServingStatus(tod::v1::ObstacleDiscovery::service_full_name(), false);
   health->SetServingStatus(false);
+  return server;
+}
 
-  HttpFrontendConfig http_config;
-  http_config.limits = HttpLimitsFrom(config);
-  http_config.retry_after_s = config.retry_after_s;
-  http_config.io_threads = config.http_threads;
-  http_config.auth = auth;
-  if (tls) {
-    Result<std::shared_ptr<boost::asio::ssl::context>> https = HttpsContext(*tls);
-    if (!https.ok()) {  // LoadTlsMaterial built one already; this cannot fail differently
-      std::cerr << "tod_server: " << https.status().message() << "\n";
-      grpc_server->Shutdown();
-      return 2;
-    }
-    http_config.tls = std::move(*https);
-  }
-  HttpFrontend http(http_config, engine, models, metrics);
-  if (Status bound = http.Bind(config.host, config.http_port); !bound.ok()) {
-    LogEvent(spdlog::level::err, "cannot listen for HTTP", {{"error", bound.message()}});
-    std::cerr << "tod_server: " << bound.message() << "\n";
-    grpc_server->Shutdown();
-    return 1;
-  }
-  http.Start();
-  LogEvent(spdlog::level::info, "listening",
-           {{"grpc", config.host + ":" + std::to_string(grpc_port)},
-            {"http", config.host + ":" + std::to_string(http.port())},
-            {"tls", !tls            ? "off"
-                    : tls->mutual() ? "mutual"
-                                    : "on"},
-            {"auth", auth ? "bearer" : "off"}});
+HttpFrontendConfig HttpConfigFrom(const ServerConfig& config, const Security& security) {
+  HttpFrontendConfig http;
+  http.limits = HttpLimitsFrom(config);
+  http.retry_after_s = config.retry_after_s;
+  http.io_threads = config.http_threads;
+  http.auth = security.auth;
+  return http;
+}
 
-  if (Status loaded = models.Load(config.model_dir); !loaded.ok()) {
-    LogEvent(spdlog::level::err, "model bundle refused", {{"error", loaded.ToString()}});
-    std::cerr << "tod_server: cannot load model bundle " << config.model_dir << ": "
-              << loaded.ToString() << "\n";
-    http.Stop();
-    grpc_server->Shutdown();
-    return 1;
+// SIGHUP: the model bundle and the tokens again; a refused one leaves the previous in service.
+void Reload(const ServerConfig& config, ModelHolder& models, ServerMetrics& metrics,
+            TokenAuthenticator* auth) {
+  LogEvent(spdlog::level::info, "reloading model", {{"dir", config.model_dir}});
+  const Status reloaded = models.Reload();
+  metrics.RecordReload(reloaded.ok());
+  if (reloaded.ok()) {
+    PublishModel(models, metrics);
+  } else {
+    LogEvent(spdlog::level::err, "reload refused; the previous model keeps serving",
+             {{"error", reloaded.ToString()}});
   }
-  PublishModel(models, metrics);
-  health->SetServingStatus(true);
-  LogEvent(spdlog::level::info, "ready");
+  if (auth == nullptr) return;
+  const Status tokens = auth->Reload();
+  metrics.RecordTokenReload(tokens.ok());
+  if (tokens.ok()) {
+    LogEvent(spdlog::level::info, "auth tokens reloaded", {{"tokens", auth->token_count()}});
+  } else {
+    LogEvent(spdlog::level::err, "token reload refused; the previous tokens stay",
+             {{"error", tokens.message()}});
+  }
+}
 
+// Serves until SIGTERM or SIGINT (returned), reloading on every SIGHUP.
+int ServeUntilStopSignal(const ServerConfig& config, ModelHolder& models, ServerMetrics& metrics,
+                         TokenAuthenticator* auth) {
   const sigset_t signals = ServerSignals();
   for (;;) {
     int signal_number = 0;
     if (sigwait(&signals, &signal_number) != 0) continue;
-    if (signal_number == SIGHUP) {
-      LogEvent(spdlog::level::info, "reloading model", {{"dir", config.model_dir}});
-      const Status reloaded = models.Reload();
-      metrics.RecordReload(reloaded.ok());
-      if (reloaded.ok()) {
-        PublishModel(models, metrics);
-      } else {
-        LogEvent(spdlog::level::err, "reload refused; the previous model keeps serving",
-                 {{"error", reloaded.ToString()}});
-      }
-      if (auth) {
-        const Status tokens = auth->Reload();
-        metrics.RecordTokenReload(tokens.ok());
-        if (tokens.ok()) {
-          LogEvent(spdlog::level::info, "auth tokens reloaded", {{"tokens", auth->token_count()}});
-        } else {
-          LogEvent(spdlog::level::err, "token reload refused; the previous tokens stay",
-                   {{"error", tokens.message()}});
-        }
-      }
-      continue;
-    }
-    LogEvent(spdlog::level::info, "draining",
-             {{"signal", signal_number == SIGTERM ? "SIGTERM" : "SIGINT"},
-              {"queued", engine.queue_depth()},
-              {"timeout_s", config.drain_timeout_s}});
-    break;
+    if (signal_number != SIGHUP) return signal_number;
+    Reload(config, models, metrics, auth);
   }
+}
 
-  // Drain: refuse new work and report not-serving, let admitted work finish until the drain
-  // deadline, then answer what is still queued with UNAVAILABLE / 503 and cancel what runs (it
-  // stops at its next stage boundary). Everything after the deadline has one second in all:
-  // answers being written get what is left of it, and the process exits at the latest then.
+// Drain: refuse new work and report not-serving, let admitted work finish until the drain
+// deadline, then answer what is still queued with UNAVAILABLE / 503 and cancel what runs (it
+// stops at its next stage boundary). Everything after the deadline has one second in all:
+// answers being written get what is left of it, and the process exits at the latest then.
+void Drain(const ServerConfig& config, InferenceEngine& engine, grpc::Server& grpc_server,
+           HttpFrontend& http) {
   using std::chrono::milliseconds;
   using std::chrono::steady_clock;
   engine.BeginDrain();
-  health->SetServingStatus(false);
+  grpc_server.GetHealthCheckService()->SetServingStatus(false);
   const steady_clock::time_point drain_deadline =
       steady_clock::now() + Milliseconds(config.drain_timeout_s);
   const steady_clock::time_point hard_limit = drain_deadline + milliseconds(950);
@@ -282,11 +255,84 @@ int RunServer(const ServerConfig& config) {
     }
   }
   // Calls still open (an idle DetectStream, say) are cancelled at the gRPC deadline.
-  grpc_server->Shutdown(std::chrono::system_clock::now() +
-                        Within(milliseconds(2000), hard_limit - milliseconds(250)));
+  grpc_server.Shutdown(std::chrono::system_clock::now() +
+                       Within(milliseconds(2000), hard_limit - milliseconds(250)));
   http.Stop(Within(milliseconds(5000), hard_limit - milliseconds(100)));
   engine.Stop();
   LogEvent(spdlog::level::info, "stopped", {{"drained", drained}});
+}
+
+}  // namespace
+
+void BlockServerSignals() {
+  const sigset_t signals = ServerSignals();
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+}
+
+int RunServer(const ServerConfig& config) {
+  BlockServerSignals();  // before any thread starts, so all of them inherit the mask
+  LogEvent(spdlog::level::info, "starting", ServerConfigToJson(config));
+  std::variant<Security, int> loaded_security = LoadSecurity(config);
+  if (const int* exit_code = std::get_if<int>(&loaded_security)) return *exit_code;
+  const Security& security = std::get<Security>(loaded_security);
+
+  ServerMetrics metrics;
+  ModelHolder models;
+  InferenceEngine engine(EngineConfigFrom(config), models, &metrics);
+  engine.Start();
+
+  // Listeners come up first and report not-ready until the model is loaded, so orchestrators
+  // can tell "starting" from "dead".
+  ObstacleDiscoveryService service(engine, models, metrics, security.auth);
+  int grpc_port = 0;
+  std::unique_ptr<grpc::Server> grpc_server = StartGrpc(config, security, service, &grpc_port);
+  if (!grpc_server) {
+    const std::string address = config.host + ":" + std::to_string(config.grpc_port);
+    LogEvent(spdlog::level::err, "cannot listen for gRPC", {{"address", address}});
+    std::cerr << "tod_server: cannot listen for gRPC on " << address
+              << " (port in use or not permitted)\n";
+    return 1;
+  }
+  HttpFrontendConfig http_config = HttpConfigFrom(config, security);
+  if (security.tls) {
+    Result<std::shared_ptr<boost::asio::ssl::context>> https = HttpsContext(*security.tls);
+    if (!https.ok()) {  // LoadTlsMaterial built one already; this cannot fail differently
+      std::cerr << "tod_server: " << https.status().message() << "\n";
+      grpc_server->Shutdown();
+      return 2;
+    }
+    http_config.tls = std::move(*https);
+  }
+  HttpFrontend http(http_config, engine, models, metrics);
+  if (Status bound = http.Bind(config.host, config.http_port); !bound.ok()) {
+    grpc_server->Shutdown();
+    return Refuse("cannot listen for HTTP", bound.message(), bound.message(), 1);
+  }
+  http.Start();
+  LogEvent(spdlog::level::info, "listening",
+           {{"grpc", config.host + ":" + std::to_string(grpc_port)},
+            {"http", config.host + ":" + std::to_string(http.port())},
+            {"tls", !security.tls            ? "off"
+                    : security.tls->mutual() ? "mutual"
+                                             : "on"},
+            {"auth", security.auth ? "bearer" : "off"}});
+
+  if (Status loaded = models.Load(config.model_dir); !loaded.ok()) {
+    http.Stop();
+    grpc_server->Shutdown();
+    return Refuse("model bundle refused", loaded.ToString(),
+                  "cannot load model bundle " + config.model_dir + ": " + loaded.ToString(), 1);
+  }
+  PublishModel(models, metrics);
+  grpc_server->GetHealthCheckService()->SetServingStatus(true);
+  LogEvent(spdlog::level::info, "ready");
+
+  const int stop_signal = ServeUntilStopSignal(config, models, metrics, security.auth.get());
+  LogEvent(spdlog::level::info, "draining",
+           {{"signal", stop_signal == SIGTERM ? "SIGTERM" : "SIGINT"},
+            {"queued", engine.queue_depth()},
+            {"timeout_s", config.drain_timeout_s}});
+  Drain(config, engine, *grpc_server, http);
   spdlog::default_logger()->flush();
   return 0;
 }

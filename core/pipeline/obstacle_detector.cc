@@ -105,6 +105,43 @@ ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
       {"training", bundle_.training},        {"eval", bundle_.eval}};
 }
 
+namespace {
+
+// A frame and options the detector can serve, checked before any stage runs: a map the bundle
+// cannot make is refused now, not after the whole frame.
+Status CheckRequest(const cv::Mat3b& bgr, const DetectOptions& options,
+                    const PipelineParams& params) {
+  if (bgr.empty()) return Status::InvalidArgument("empty image");
+  if (bgr.cols < 16 || bgr.rows < 16)
+    return Status::InvalidArgument("image too small: " + std::to_string(bgr.cols) + "x" +
+                                   std::to_string(bgr.rows) + " (at least 16x16)");
+  if (options.map_kind == MapKind::kCalibrated)
+    return CalibratedMapAvailable(params.obstacle_calibration);
+  return Status::Ok();
+}
+
+// The `max_proposals` best proposals by fused score (ties: by ORDR, then list order).
+std::vector<Proposal> BestProposals(const RegressedProposals& regressed,
+                                    const std::vector<float>& fused, int max_proposals) {
+  std::vector<std::size_t> order(fused.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    if (fused[a] != fused[b]) return fused[a] > fused[b];
+    return regressed.ordr[a] > regressed.ordr[b];
+  });
+  const std::size_t n = std::min<std::size_t>(order.size(), std::max(0, max_proposals));
+  std::vector<Proposal> best;
+  best.reserve(n);
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = order[r];
+    best.push_back(
+        {regressed.proposals.boxes[i].box, fused[i], regressed.ordr[i], regressed.obdr[i]});
+  }
+  return best;
+}
+
+}  // namespace
+
 Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
                                            const DetectOptions& options) const {
   return Detect(bgr, options, nullptr);
@@ -112,16 +149,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
 
 Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOptions& options,
                                            MapSuperpixels* superpixels) const {
-  if (bgr.empty()) return Status::InvalidArgument("empty image");
-  if (bgr.cols < 16 || bgr.rows < 16)
-    return Status::InvalidArgument("image too small: " + std::to_string(bgr.cols) + "x" +
-                                   std::to_string(bgr.rows) + " (at least 16x16)");
-  // A map the bundle cannot make is refused before any stage runs, not after the whole frame.
-  if (options.map_kind == MapKind::kCalibrated) {
-    if (Status available = CalibratedMapAvailable(bundle_.params.obstacle_calibration);
-        !available.ok())
-      return available;
-  }
+  if (Status st = CheckRequest(bgr, options, bundle_.params); !st.ok()) return st;
   StageTimer timer(options.cancelled);  // asks options.cancelled at every stage boundary
   const FrameBudget budget(std::chrono::steady_clock::now(), options.budget_ms);
   const int threads = std::max(1, options.threads);
@@ -187,18 +215,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   out.obstacles = ScoreObstacles(components, accumulated.boxes, bundle_.params, options);
   timer.Mark("probability_map");
 
-  std::vector<std::size_t> order(fused.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    if (fused[a] != fused[b]) return fused[a] > fused[b];
-    return regressed.ordr[a] > regressed.ordr[b];
-  });
-  const std::size_t n = std::min<std::size_t>(order.size(), std::max(0, options.max_proposals));
-  for (std::size_t r = 0; r < n; ++r) {
-    const std::size_t i = order[r];
-    out.proposals.push_back(
-        {regressed.proposals.boxes[i].box, fused[i], regressed.ordr[i], regressed.obdr[i]});
-  }
+  out.proposals = BestProposals(regressed, fused, options.max_proposals);
   if (options.want_probability_map) out.probability = std::move(maps->served);
   if (superpixels != nullptr) *superpixels = {oaocc.superpixels, oaocc.r1};
   out.timings = timer.times();
