@@ -15,19 +15,18 @@
 namespace tod {
 namespace {
 
-constexpr int kMaxProposals = 1000;
 const std::vector<int> kTableN = {200, 400, 600, 800, 1000};
 
 VariantCurves Curves(const RecallAccumulator& acc) {
   VariantCurves c;
-  for (int n = 0; n <= kMaxProposals; n += 5) {
+  for (int n = 0; n <= kEvalMaxProposals; n += 5) {
     c.n_grid.push_back(n);
     c.recall_at_07.push_back(acc.Recall(n, 0.7));
     c.average_recall.push_back(acc.AverageRecall(n));
   }
   for (double tau : RecallIouThresholds()) {
     c.iou_grid.push_back(tau);
-    c.recall_at_1000.push_back(acc.Recall(kMaxProposals, tau));
+    c.recall_at_1000.push_back(acc.Recall(kEvalMaxProposals, tau));
   }
   for (int n : kTableN) c.ar_table[n] = acc.AverageRecall(n);
   return c;
@@ -61,8 +60,10 @@ namespace {
 class EvalTotals {
  public:
   explicit EvalTotals(bool calibrated_map) : map_variants_(RegressionVariants()) {
-    for (const auto& v : ProposalVariants()) recall_.emplace(v, RecallAccumulator(kMaxProposals));
-    for (const auto& v : RegressionVariants()) recall_.emplace(v, RecallAccumulator(kMaxProposals));
+    for (const auto& v : ProposalVariants())
+      recall_.emplace(v, RecallAccumulator(kEvalMaxProposals));
+    for (const auto& v : RegressionVariants())
+      recall_.emplace(v, RecallAccumulator(kEvalMaxProposals));
     if (calibrated_map) map_variants_.push_back(kCalibratedMapVariant);
     for (const auto& v : map_variants_) {
       roc_.emplace(v, PixelRocAccumulator());

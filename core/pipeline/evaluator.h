@@ -29,6 +29,10 @@ struct EvalOptions {
   std::function<void(const std::string&)> progress;
 };
 
+// Proposals per frame that average recall counts (AR@1000, the paper's N) and the EB baseline
+// is asked for.
+inline constexpr int kEvalMaxProposals = 1000;
+
 inline const std::vector<std::string>& ProposalVariants() {
   static const std::vector<std::string> v = {"EB", "OLP@1", "OAOCC+OLP@1", "OAOCC+OLP@4",
                                              "OAOCC+OLP@4+MS"};

@@ -11,8 +11,6 @@
 namespace tod {
 namespace {
 
-constexpr int kMaxProposals = 1000;
-
 std::vector<Box> BoxesOf(const std::vector<ScoredBox>& boxes) {
   std::vector<Box> out;
   out.reserve(boxes.size());
@@ -43,7 +41,7 @@ Status AddPlainEdgeBaselines(const ModelBundle& bundle, const Sample& s, const F
                             OcclusionFeatureOptions{}, plain_params, /*enhance=*/false);
   if (!computed.ok()) return computed.status();
   const OcclusionEdges& plain = *computed;
-  out.ranked["EB"] = EdgeBoxesBaseline(plain.base_edge, plain.r1, kMaxProposals);
+  out.ranked["EB"] = EdgeBoxesBaseline(plain.base_edge, plain.r1, kEvalMaxProposals);
   const ProposalSet olp1 = ProposeBoxes(
       plain, geo.regions, bundle.params.boxes,
       {1, false, bundle.params.size_filter, bundle.params.region_merge_iou}, geo.size_filter);
