@@ -49,9 +49,10 @@ struct ChunkRun {
   size_t skipped = 0;   // chunks not run because the deadline had passed
 };
 
-// Runs body(scorer, chunk) for chunk = 0 .. chunks - 1 on `threads` threads (the caller's
-// included), each with its own copy of the scorer. Which thread runs which chunk varies, so
-// bodies write only to their chunk's own output. With a deadline (not Clock::time_point::max()),
+// Runs body(scorer, worker, chunk) for chunk = 0 .. chunks - 1 on `threads` threads (the
+// caller's included), each with its own copy of the scorer and its own index worker in
+// [0, threads) (the caller's is 0). Which thread runs which chunk varies, so bodies write only to
+// their chunk's own output or to their worker's. With a deadline (not Clock::time_point::max()),
 // chunks are handed out in a scattered order and none is started once it has passed.
 template <typename Body>
 ChunkRun ParallelChunks(const BoxScorer& prototype, size_t chunks, int threads,
@@ -63,12 +64,12 @@ ChunkRun ParallelChunks(const BoxScorer& prototype, size_t chunks, int threads,
   std::atomic<long long> walks{0};
   std::atomic<bool> failed{false};
   std::exception_ptr failure;
-  const auto work = [&]() {
+  const auto work = [&](size_t worker) {
     try {
       BoxScorer scorer(prototype);  // own walk scratch, shared map tables
       for (size_t turn = next_turn++; turn < chunks && !failed; turn = next_turn++) {
         if (limited && Clock::now() > deadline) break;
-        body(scorer, (turn * step) % chunks);
+        body(scorer, worker, (turn * step) % chunks);
         ++done;
       }
       walks += scorer.past_early_exit() - prototype.past_early_exit();
@@ -80,20 +81,72 @@ ChunkRun ParallelChunks(const BoxScorer& prototype, size_t chunks, int threads,
       static_cast<int>(std::min<size_t>(static_cast<size_t>(threads), chunks)) - 1;
   {
     std::vector<std::jthread> helpers;
-    for (int t = 0; t < helpers_wanted; ++t) helpers.emplace_back(work);
-    work();
+    for (int t = 0; t < helpers_wanted; ++t) helpers.emplace_back(work, static_cast<size_t>(t) + 1);
+    work(0);
   }  // joins the helpers
   if (failure) std::rethrow_exception(failure);
   return ChunkRun{walks.load(), chunks - done.load()};
 }
 
+// The windows with a non-zero score that one worker's column chunks found, chunk after chunk in
+// the order it ran them, and their grid rows. One buffer per worker, not per chunk: a chunk's own
+// vectors grew from empty, and the threads of a request then took turns at the allocator's lock
+// (one heap, heap_tuning.h) hundreds of times a frame. Aligned so that two workers' vectors do
+// not share a cache line.
+struct alignas(64) WorkerHits {
+  std::vector<ScoreWindow> hits;
+  std::vector<int> rows;
+};
+
+// Where a column chunk's hits lie: [begin, end) of its worker's buffers; worker -1 if the
+// deadline left it unscanned.
 struct ColumnChunk {
-  std::vector<ScoreWindow> hits;  // windows with a non-zero score, grid order
-  std::vector<int> rows;          // grid row index of each hit
-  std::vector<int> hit_end;       // per column of the chunk: end of its hits in `hits`
+  int worker = -1;
+  size_t begin = 0, end = 0;
   long long windows = 0;
   long long walks = 0;
 };
+
+// The column scan's hits in grid order, their grid rows, and where each column's hits begin
+// (column i: [column_begin[i], column_begin[i + 1])).
+struct GridHits {
+  std::vector<ScoreWindow> hits;
+  std::vector<int> rows;
+  std::vector<size_t> column_begin;
+};
+
+// Puts the chunks' hits back in grid order (chunk after chunk, each from its worker's buffers)
+// and adds the chunks' counters to `stats`, with the columns of chunks never scanned as skipped.
+GridHits GatherInGridOrder(const std::vector<ColumnChunk>& scanned,
+                           const std::vector<WorkerHits>& found,
+                           const std::vector<int>& column_hits, EdgeBoxStats& stats) {
+  GridHits out;
+  size_t total = 0;
+  for (const ColumnChunk& chunk : scanned) total += chunk.end - chunk.begin;
+  out.hits.reserve(total);
+  out.rows.reserve(total);
+  for (size_t c = 0; c < scanned.size(); ++c) {
+    const ColumnChunk& chunk = scanned[c];
+    if (chunk.worker < 0) {
+      const size_t first = c * kColumnsPerChunk;
+      stats.columns_skipped +=
+          static_cast<long long>(std::min(column_hits.size(), first + kColumnsPerChunk) - first);
+      continue;
+    }
+    stats.windows_visited += chunk.windows;
+    stats.windows_past_early_exit += chunk.walks;
+    const WorkerHits& from = found[static_cast<size_t>(chunk.worker)];
+    const auto first = static_cast<std::ptrdiff_t>(chunk.begin);
+    const auto last = static_cast<std::ptrdiff_t>(chunk.end);
+    out.hits.insert(out.hits.end(), from.hits.begin() + first, from.hits.begin() + last);
+    out.rows.insert(out.rows.end(), from.rows.begin() + first, from.rows.begin() + last);
+  }
+  out.column_begin.reserve(column_hits.size() + 1);
+  out.column_begin.push_back(0);
+  for (const int count : column_hits) out.column_begin.push_back(out.column_begin.back() + count);
+  stats.windows_nonzero = static_cast<long long>(out.hits.size());
+  return out;
+}
 
 // Of `candidates` (grid order), all or the refine_limit best by grid score (ties: grid order),
 // in grid order.
@@ -184,9 +237,14 @@ std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams&
   // Pass 1: score every grid window (steps 4-6).
   const size_t column_chunks = (columns.size() + kColumnsPerChunk - 1) / kColumnsPerChunk;
   std::vector<ColumnChunk> scanned(column_chunks);
-  const ChunkRun scan =
-      ParallelChunks(scorer, column_chunks, threads, params.deadline, [&](BoxScorer& s, size_t c) {
+  std::vector<WorkerHits> found(static_cast<size_t>(std::max(1, threads)));
+  std::vector<int> column_hits(columns.size(), 0);  // stays 0 for columns never scanned
+  const ChunkRun scan = ParallelChunks(
+      scorer, column_chunks, threads, params.deadline, [&](BoxScorer& s, size_t worker, size_t c) {
         ColumnChunk& out = scanned[c];
+        WorkerHits& own = found[worker];
+        out.worker = static_cast<int>(worker);
+        out.begin = own.hits.size();
         const size_t end = std::min(columns.size(), (c + 1) * kColumnsPerChunk);
         const long long walks_before = s.past_early_exit();
         for (size_t i = c * kColumnsPerChunk; i < end; ++i) {
@@ -198,39 +256,21 @@ std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams&
             clamped_tops = admitted_tops_of(columns[i].x, shape);
             tops = &clamped_tops;
           }
+          const size_t before = own.hits.size();
           out.windows += s.ScoreColumn(columns[i].x, shape.width, shape.height, shape.stride_y,
-                                       tops, bar, out.hits, &out.rows);
-          out.hit_end.push_back(static_cast<int>(out.hits.size()));
+                                       tops, bar, own.hits, &own.rows);
+          column_hits[i] = static_cast<int>(own.hits.size() - before);
         }
+        out.end = own.hits.size();
         out.walks = s.past_early_exit() - walks_before;
       });
   stats.scorings += scan.walks;
-  if (scan.skipped > 0) {
-    stats.truncated = true;
-    // A chunk never scanned has no hit_end entries; give it one empty entry per column so that
-    // column_begin below still indexes `columns`.
-    for (size_t c = 0; c < column_chunks; ++c) {
-      const size_t in_chunk =
-          std::min(columns.size(), (c + 1) * kColumnsPerChunk) - c * kColumnsPerChunk;
-      if (scanned[c].hit_end.empty()) {
-        scanned[c].hit_end.assign(in_chunk, 0);
-        stats.columns_skipped += static_cast<long long>(in_chunk);
-      }
-    }
-  }
-  std::vector<ScoreWindow> hits;
-  std::vector<int> hit_rows;
-  std::vector<size_t> column_begin{0};  // hits of column i: [column_begin[i], column_begin[i+1])
-  for (ColumnChunk& chunk : scanned) {
-    stats.windows_visited += chunk.windows;
-    stats.windows_past_early_exit += chunk.walks;
-    for (const int end : chunk.hit_end) column_begin.push_back(hits.size() + end);
-    hits.insert(hits.end(), chunk.hits.begin(), chunk.hits.end());
-    hit_rows.insert(hit_rows.end(), chunk.rows.begin(), chunk.rows.end());
-    chunk.hits = {};
-    chunk.rows = {};
-  }
-  stats.windows_nonzero = static_cast<long long>(hits.size());
+  if (scan.skipped > 0) stats.truncated = true;
+  GridHits grid = GatherInGridOrder(scanned, found, column_hits, stats);
+  found = {};
+  std::vector<ScoreWindow>& hits = grid.hits;
+  const std::vector<int>& hit_rows = grid.rows;
+  const std::vector<size_t>& column_begin = grid.column_begin;
 
   // Pass 2: refinement (step 7) in grid order - neighbouring windows share cache lines, which
   // matters more than anything an order by score bounds could skip - then NMS (step 8).
@@ -250,8 +290,8 @@ std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams&
     chosen = BestByGridScore(hits, std::move(chosen), params.refine_limit);
     const size_t chunks = (chosen.size() + kRefinementsPerChunk - 1) / kRefinementsPerChunk;
     std::atomic<long long> refined_windows{0};
-    const ChunkRun refined =
-        ParallelChunks(scorer, chunks, threads, params.deadline, [&](BoxScorer& s, size_t c) {
+    const ChunkRun refined = ParallelChunks(
+        scorer, chunks, threads, params.deadline, [&](BoxScorer& s, size_t, size_t c) {
           const size_t end = std::min(chosen.size(), (c + 1) * kRefinementsPerChunk);
           for (size_t i = c * kRefinementsPerChunk; i < end; ++i) s.Refine(hits[chosen[i]]);
           refined_windows += static_cast<long long>(end - c * kRefinementsPerChunk);
