@@ -73,11 +73,13 @@ void WinningGradientRow(const float* up, const float* row, const float* down, in
 }
 
 // Runs `per_row(y, dx, dy, scratch)` with the winning differences of every row of `luv` and a
-// scratch row of luv.cols floats. Rows only read `luv` and write their own outputs, so they run on
-// OpenCV's pool (as wide as the request's threads) with the same values for any width.
+// scratch row of luv.cols floats. Rows only read `luv` and write their own outputs, so they run in
+// bands on OpenCV's pool (as wide as the request's threads) with the same values for any width.
+// Bands, not OpenCV's default split: that gave every row a stripe of its own, whose three scratch
+// rows took the shared heap's lock three times a row while the other thread did the same.
 template <typename PerRow>
 void ForEachGradientRow(const cv::Mat3f& luv, const PerRow& per_row) {
-  cv::parallel_for_(cv::Range(0, luv.rows), [&](const cv::Range& rows) {
+  ForEachRowBand(luv.rows, [&](const cv::Range& rows) {
     std::vector<float> dx(static_cast<std::size_t>(luv.cols));
     std::vector<float> dy(static_cast<std::size_t>(luv.cols));
     std::vector<float> scratch(static_cast<std::size_t>(luv.cols));
