@@ -110,3 +110,32 @@ TEST(NmsTest, GridIndexEqualsPlainGreedyNmsOnWideRanges) {
 
 }  // namespace
 }  // namespace tod
+
+namespace tod {
+namespace {
+
+// Many small boxes over a tall strip, as a real frame's far layers give: the grids of the small
+// bins get columns of hundreds of cells, and a candidate searches cells on every side of its own.
+TEST(NmsTest, GridIndexEqualsPlainGreedyNmsOnDenseSmallBoxes) {
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> x(0, 900), y(0, 700), size(2, 24), jitter(-3, 3);
+  std::uniform_real_distribution<float> score(0.f, 1.f);
+  std::vector<ScoredBox> boxes;
+  for (int i = 0; i < 1500; ++i) {
+    const Box base{x(rng), y(rng), size(rng), size(rng)};
+    for (int k = 0; k < 3; ++k) {
+      boxes.push_back({{base.x + jitter(rng), base.y + jitter(rng),
+                        std::max(1, base.w + jitter(rng)), std::max(1, base.h + jitter(rng))},
+                       score(rng)});
+    }
+  }
+  for (const float thr : {0.4f, 0.65f, 0.8f}) {
+    const auto expected = Reference(boxes, thr, 100000);
+    const auto got = NonMaximumSuppression(boxes, thr, 100000);
+    ASSERT_EQ(got.size(), expected.size()) << thr;
+    for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].box, expected[i].box) << thr << i;
+  }
+}
+
+}  // namespace
+}  // namespace tod
