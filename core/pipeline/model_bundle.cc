@@ -126,50 +126,16 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   return Status::Ok();
 }
 
-Result<ModelBundle> LoadModelBundle(const std::string& dir) {
-  const fs::path root(dir);
-  std::error_code ec;
-  if (!fs::is_directory(root, ec))
-    return Status::NotFound(dir + ": model bundle directory does not exist");
-  auto manifest_text = ReadFile(root / kManifest);
-  if (!manifest_text.ok()) return manifest_text.status();
-  const std::string manifest_path = (root / kManifest).string();
-  nlohmann::json manifest;
-  try {
-    manifest = nlohmann::json::parse(*manifest_text);
-  } catch (const nlohmann::json::exception& e) {
-    return Status::DataLoss(manifest_path + ": not valid JSON (" + e.what() + ")");
-  }
-  ModelBundle bundle;
-  try {
-    const Result<int> version = JsonToInt(manifest.at("format_version"), "format_version");
-    if (!version.ok())
-      return Status::InvalidArgument(manifest_path + ": " + version.status().message());
-    const int format = *version;
-    if (format != kBundleFormatVersion)
-      return Status::FailedPrecondition(manifest_path + ": format_version " +
-                                        std::to_string(format) + ", this build reads " +
-                                        std::to_string(kBundleFormatVersion));
-    bundle.version = manifest.value("version", "");
-    bundle.created = manifest.value("created", "");
-    bundle.edge_kind = manifest.at("edge_source").get<std::string>();
-    auto params = PipelineParamsFromJson(manifest.at("params"));
-    if (!params.ok())
-      return Status::InvalidArgument(manifest_path + ": " + params.status().message());
-    bundle.params = *params;
-    auto regions = MultilayerRegions::FromJson(manifest.at("regions"));
-    if (!regions.ok())
-      return Status::InvalidArgument(manifest_path + ": " + regions.status().message());
-    bundle.regions = *regions;
-    bundle.size_filter = SizeFilter::FromJson(manifest.at("size_filter"));
-    bundle.training = manifest.value("training", nlohmann::json());
-    bundle.eval = manifest.value("eval", nlohmann::json());
-  } catch (const nlohmann::json::exception& e) {
-    return Status::InvalidArgument(manifest_path + ": " + e.what());
-  }
+namespace {
 
-  // Every learned file: present, of the recorded size and checksum, then parsed.
-  auto checked = [&](const std::string& name) -> Result<std::string> {
+// The bundle directory's manifest and what it says about the learned files, which are read
+// only through it: present, of the recorded size and checksum.
+struct BundleFiles {
+  fs::path root;
+  std::string manifest_path;
+  nlohmann::json manifest;
+
+  Result<std::string> Checked(const std::string& name) const {
     const fs::path path = root / name;
     auto bytes = ReadFile(path);
     if (!bytes.ok()) return bytes.status();
@@ -184,67 +150,137 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
     if (ChecksumHex(*bytes) != entry.value("fnv1a64", ""))
       return Status::DataLoss(path.string() + ": checksum mismatch (file corrupted)");
     return bytes;
-  };
-  auto load_forest = [&](const char* name, RandomForest& forest) -> Status {
-    auto bytes = checked(name);
-    if (!bytes.ok()) return bytes.status();
-    auto loaded = DecodeModel<RandomForest>(*bytes, (root / name).string());
-    if (!loaded.ok()) return loaded.status();
-    forest = std::move(*loaded);
-    return Status::Ok();
-  };
-  Status st = load_forest(kOrdrFile, bundle.ordr);
-  if (!st.ok()) return st;
-  if ((st = load_forest(kObdrFile, bundle.obdr)); !st.ok()) return st;
-  {
-    auto bytes = checked(kOcclusionFile);
-    if (!bytes.ok()) return bytes.status();
-    auto loaded = DecodeModel<OcclusionClassifier>(*bytes, (root / kOcclusionFile).string());
-    if (!loaded.ok()) return loaded.status();
-    bundle.occlusion = std::move(*loaded);
-    // No silent fallback: an untrained classifier would paint mean-Ê boundaries instead of the
-    // learned occlusion edges. Only a manifest that switches the part off on purpose loads one.
-    const nlohmann::json parts = bundle.training.is_object()
-                                     ? bundle.training.value("parts", nlohmann::json::object())
-                                     : nlohmann::json::object();
-    const bool deliberately_off =
-        parts.contains("occlusion") && parts["occlusion"].value("off", false);
-    if (!bundle.occlusion.trained() && !deliberately_off)
-      return Status::FailedPrecondition(
-          (root / kOcclusionFile).string() +
-          ": the occlusion classifier is untrained and the manifest does not switch it off "
-          "(training.parts.occlusion.off)");
   }
-  if (bundle.edge_kind == "pixel_forest") {
-    auto bytes = checked(kEdgesFile);
+
+  // A checked file parsed as a model of type T.
+  template <typename T>
+  Result<T> Decoded(const std::string& name) const {
+    auto bytes = Checked(name);
     if (!bytes.ok()) return bytes.status();
-    auto loaded = DecodeModel<PixelEdgeClassifier>(*bytes, (root / kEdgesFile).string());
+    return DecodeModel<T>(*bytes, (root / name).string());
+  }
+};
+
+Result<BundleFiles> OpenBundle(const std::string& dir) {
+  BundleFiles files;
+  files.root = fs::path(dir);
+  std::error_code ec;
+  if (!fs::is_directory(files.root, ec))
+    return Status::NotFound(dir + ": model bundle directory does not exist");
+  auto manifest_text = ReadFile(files.root / kManifest);
+  if (!manifest_text.ok()) return manifest_text.status();
+  files.manifest_path = (files.root / kManifest).string();
+  try {
+    files.manifest = nlohmann::json::parse(*manifest_text);
+  } catch (const nlohmann::json::exception& e) {
+    return Status::DataLoss(files.manifest_path + ": not valid JSON (" + e.what() + ")");
+  }
+  return files;
+}
+
+// The manifest's own fields: format version, parameters, regions, size filter, records.
+Status ReadManifestFields(const BundleFiles& files, ModelBundle& bundle) {
+  const nlohmann::json& manifest = files.manifest;
+  const std::string& where = files.manifest_path;
+  try {
+    const Result<int> version = JsonToInt(manifest.at("format_version"), "format_version");
+    if (!version.ok()) return Status::InvalidArgument(where + ": " + version.status().message());
+    if (*version != kBundleFormatVersion)
+      return Status::FailedPrecondition(where + ": format_version " + std::to_string(*version) +
+                                        ", this build reads " +
+                                        std::to_string(kBundleFormatVersion));
+    bundle.version = manifest.value("version", "");
+    bundle.created = manifest.value("created", "");
+    bundle.edge_kind = manifest.at("edge_source").get<std::string>();
+    auto params = PipelineParamsFromJson(manifest.at("params"));
+    if (!params.ok()) return Status::InvalidArgument(where + ": " + params.status().message());
+    bundle.params = *params;
+    auto regions = MultilayerRegions::FromJson(manifest.at("regions"));
+    if (!regions.ok()) return Status::InvalidArgument(where + ": " + regions.status().message());
+    bundle.regions = *regions;
+    bundle.size_filter = SizeFilter::FromJson(manifest.at("size_filter"));
+    bundle.training = manifest.value("training", nlohmann::json());
+    bundle.eval = manifest.value("eval", nlohmann::json());
+  } catch (const nlohmann::json::exception& e) {
+    return Status::InvalidArgument(where + ": " + e.what());
+  }
+  return Status::Ok();
+}
+
+// ORDR and OBDR. The manifest's feature set decides the row width; a forest of the other width
+// was trained on other features, and reading its rows shifted would be silently wrong.
+Status LoadRegressors(const BundleFiles& files, ModelBundle& bundle) {
+  auto ordr = files.Decoded<RandomForest>(kOrdrFile);
+  if (!ordr.ok()) return ordr.status();
+  auto obdr = files.Decoded<RandomForest>(kObdrFile);
+  if (!obdr.ok()) return obdr.status();
+  bundle.ordr = std::move(*ordr);
+  bundle.obdr = std::move(*obdr);
+  const int features = ProposalFeatureCount(bundle.params);
+  if (bundle.ordr.num_features() == features && bundle.obdr.num_features() == features)
+    return Status::Ok();
+  return Status::DataLoss((files.root / kOrdrFile).string() + ": regressors must take " +
+                          std::to_string(features) + " features (params.vertical_edge_feature " +
+                          (bundle.params.vertical_edge_feature ? "true" : "false") +
+                          ", params.orientation_entropy_feature " +
+                          (bundle.params.orientation_entropy_feature ? "true" : "false") +
+                          "), not " + std::to_string(bundle.ordr.num_features()) + " / " +
+                          std::to_string(bundle.obdr.num_features()));
+}
+
+// No silent fallback: an untrained classifier would paint mean-Ê boundaries instead of the
+// learned occlusion edges. Only a manifest that switches the part off on purpose loads one.
+Status LoadOcclusionClassifier(const BundleFiles& files, ModelBundle& bundle) {
+  auto loaded = files.Decoded<OcclusionClassifier>(kOcclusionFile);
+  if (!loaded.ok()) return loaded.status();
+  bundle.occlusion = std::move(*loaded);
+  const nlohmann::json parts = bundle.training.is_object()
+                                   ? bundle.training.value("parts", nlohmann::json::object())
+                                   : nlohmann::json::object();
+  const bool deliberately_off =
+      parts.contains("occlusion") && parts["occlusion"].value("off", false);
+  if (bundle.occlusion.trained() || deliberately_off) return Status::Ok();
+  return Status::FailedPrecondition(
+      (files.root / kOcclusionFile).string() +
+      ": the occlusion classifier is untrained and the manifest does not switch it off "
+      "(training.parts.occlusion.off)");
+}
+
+// The base edge source the manifest names: the trained pixel forest, the gradient, or SED.
+Status LoadEdgeSource(const BundleFiles& files, ModelBundle& bundle) {
+  if (bundle.edge_kind == "pixel_forest") {
+    auto loaded = files.Decoded<PixelEdgeClassifier>(kEdgesFile);
     if (!loaded.ok()) return loaded.status();
     bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*loaded));
-  } else if (bundle.edge_kind == "gradient") {
+    return Status::Ok();
+  }
+  if (bundle.edge_kind == "gradient") {
     bundle.edges = CreateGradientEdgeSource(bundle.params.gradient_edges);
-  } else if (bundle.edge_kind == "sed") {
-    bundle.sed_model_file = manifest.value("sed_model_file", "sed_model.yml.gz");
-    auto bytes = checked(bundle.sed_model_file);
+    return Status::Ok();
+  }
+  if (bundle.edge_kind == "sed") {
+    bundle.sed_model_file = files.manifest.value("sed_model_file", "sed_model.yml.gz");
+    auto bytes = files.Checked(bundle.sed_model_file);
     if (!bytes.ok()) return bytes.status();
-    auto sed = CreateSedEdgeSource((root / bundle.sed_model_file).string());
+    auto sed = CreateSedEdgeSource((files.root / bundle.sed_model_file).string());
     if (!sed.ok()) return sed.status();
     bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
-  } else {
-    return Status::InvalidArgument(manifest_path + ": unknown edge_source '" + bundle.edge_kind +
-                                   "'");
+    return Status::Ok();
   }
-  // The manifest's feature set decides the row width; a forest of the other width was trained on
-  // other features, and reading its rows shifted would be silently wrong.
-  const int features = ProposalFeatureCount(bundle.params);
-  if (bundle.ordr.num_features() != features || bundle.obdr.num_features() != features)
-    return Status::DataLoss((root / kOrdrFile).string() + ": regressors must take " +
-                            std::to_string(features) + " features (params.vertical_edge_feature " +
-                            (bundle.params.vertical_edge_feature ? "true" : "false") +
-                            ", params.orientation_entropy_feature " +
-                            (bundle.params.orientation_entropy_feature ? "true" : "false") +
-                            "), not " + std::to_string(bundle.ordr.num_features()) + " / " +
-                            std::to_string(bundle.obdr.num_features()));
+  return Status::InvalidArgument(files.manifest_path + ": unknown edge_source '" +
+                                 bundle.edge_kind + "'");
+}
+
+}  // namespace
+
+Result<ModelBundle> LoadModelBundle(const std::string& dir) {
+  auto files = OpenBundle(dir);
+  if (!files.ok()) return files.status();
+  ModelBundle bundle;
+  for (const auto step :
+       {ReadManifestFields, LoadRegressors, LoadOcclusionClassifier, LoadEdgeSource}) {
+    if (Status st = step(*files, bundle); !st.ok()) return st;
+  }
   return bundle;
 }
 
