@@ -133,11 +133,8 @@ class Sender {
   std::unique_ptr<httplib::Client> http_;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"tod_load: load generator for tod_server (gRPC or HTTP)"};
-  LoadArgs args;
+// The command line; returns the --concurrency option, whose default depends on the loop.
+CLI::Option* AddLoadOptions(CLI::App& app, LoadArgs& args) {
   app.add_option("--addr", args.addr, "Server address HOST:PORT (gRPC port, or HTTP with --http)")
       ->required();
   app.add_option("--images", args.images_dir, "Folder of .png/.jpg frames to cycle through")
@@ -165,42 +162,42 @@ int main(int argc, char** argv) {
   app.add_option("--tls-key", args.tls_key, "PEM key of --tls-cert");
   app.add_option("--token-file", args.token_file,
                  "File whose first line is the bearer token to send");
-  CLI11_PARSE(app, argc, argv);
-  auto connection =
-      tod::client::LoadConnectionOptions(args.tls_ca, args.tls_cert, args.tls_key, args.token_file);
-  if (!connection.ok()) {
-    std::cerr << "tod_load: " << connection.status().message() << "\n";
-    return 2;
-  }
-  args.connection = std::move(*connection);
-  const bool open_loop = args.rate > 0;
-  if (open_loop && concurrency->count() == 0) args.concurrency = 64;
+  return concurrency;
+}
 
+// The request bodies to cycle through: the frames as they are, or (--corrupt) damaged versions
+// of the first kCorruptFrames.
+tod::Result<std::vector<Image>> LoadImages(const LoadArgs& args) {
   auto paths = tod::client::CollectImages({args.images_dir});
-  if (!paths.ok()) {
-    std::cerr << "tod_load: " << paths.status().message() << "\n";
-    return 2;
-  }
+  if (!paths.ok()) return paths.status();
   std::vector<Image> images;
   size_t corrupted_frames = 0;
   for (const std::string& path : *paths) {
     if (args.corrupt && corrupted_frames == kCorruptFrames) break;
     auto bytes = tod::client::ReadFileBytes(path);
-    if (!bytes.ok()) {
-      std::cerr << "tod_load: " << bytes.status().message() << "\n";
-      return 2;
-    }
+    if (!bytes.ok()) return bytes.status();
     if (!args.corrupt) {
       images.push_back({path, std::move(*bytes), tod::client::ContentTypeFor(path)});
-    } else {
-      for (tod::client::RequestBody& body :
-           tod::client::CorruptBodies(*bytes, static_cast<uint32_t>(corrupted_frames++))) {
-        images.push_back({path + " (" + body.name + ")", std::move(body.bytes), body.content_type});
-      }
+      continue;
+    }
+    for (tod::client::RequestBody& body :
+         tod::client::CorruptBodies(*bytes, static_cast<uint32_t>(corrupted_frames++))) {
+      images.push_back({path + " (" + body.name + ")", std::move(body.bytes), body.content_type});
     }
   }
+  return images;
+}
 
-  tod::client::TodGrpcClient grpc_client(args.addr, args.connection);
+struct LoadRun {
+  std::vector<tod::client::LoadSample> samples;  // those scheduled after the warm-up
+  double measured_s = 0;
+};
+
+// Runs the senders for warm-up plus duration. Closed loop: each sends again when answered;
+// open loop: sender t takes the slots t, t + N, ... of the fixed schedule.
+LoadRun RunSenders(const LoadArgs& args, const std::vector<Image>& images,
+                   tod::client::TodGrpcClient& grpc_client) {
+  const bool open_loop = args.rate > 0;
   const Clock::time_point start = Clock::now();
   const Clock::time_point measure_from =
       start + std::chrono::microseconds(static_cast<long long>(args.warmup_s * 1e6));
@@ -208,7 +205,7 @@ int main(int argc, char** argv) {
       measure_from + std::chrono::microseconds(static_cast<long long>(args.duration_s * 1e6));
   std::atomic<long long> next_image{0};
   std::mutex samples_mutex;
-  std::vector<tod::client::LoadSample> samples;
+  LoadRun run;
 
   std::vector<std::thread> threads;
   for (int t = 0; t < args.concurrency; ++t) {
@@ -230,16 +227,42 @@ int main(int argc, char** argv) {
         if (scheduled >= measure_from) mine.push_back(sample);
       }
       std::lock_guard lock(samples_mutex);
-      samples.insert(samples.end(), mine.begin(), mine.end());
+      run.samples.insert(run.samples.end(), mine.begin(), mine.end());
     });
   }
   for (std::thread& thread : threads) thread.join();
   // Closed loop: the window closes when the last in-flight request returns.
-  const double measured_s =
+  run.measured_s =
       open_loop ? args.duration_s
                 : std::chrono::duration<double>(std::max(Clock::now(), end) - measure_from).count();
+  return run;
+}
 
-  tod::client::LoadReport report = tod::client::Summarize(samples, measured_s);
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tod_load: load generator for tod_server (gRPC or HTTP)"};
+  LoadArgs args;
+  CLI::Option* concurrency = AddLoadOptions(app, args);
+  CLI11_PARSE(app, argc, argv);
+  auto connection =
+      tod::client::LoadConnectionOptions(args.tls_ca, args.tls_cert, args.tls_key, args.token_file);
+  if (!connection.ok()) {
+    std::cerr << "tod_load: " << connection.status().message() << "\n";
+    return 2;
+  }
+  args.connection = std::move(*connection);
+  const bool open_loop = args.rate > 0;
+  if (open_loop && concurrency->count() == 0) args.concurrency = 64;
+  const auto images = LoadImages(args);
+  if (!images.ok()) {
+    std::cerr << "tod_load: " << images.status().message() << "\n";
+    return 2;
+  }
+
+  tod::client::TodGrpcClient grpc_client(args.addr, args.connection);
+  const LoadRun run = RunSenders(args, *images, grpc_client);
+  tod::client::LoadReport report = tod::client::Summarize(run.samples, run.measured_s);
   report.protocol = args.http ? "http" : "grpc";
   report.mode = open_loop ? "open" : "closed";
   report.concurrency = args.concurrency;

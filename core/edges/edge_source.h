@@ -115,9 +115,4 @@ class PixelEdgeClassifier : public EdgeSource {
   EdgeChannelParams channel_params_;
 };
 
-// Builds the edge source of a model bundle. kind "gradient": default parameters, `in` unused;
-// "pixel_forest": PixelEdgeClassifier::Load(*in); "sed": `what` is the model file path.
-Result<std::unique_ptr<EdgeSource>> LoadEdgeSource(const std::string& kind, BinaryReader* in,
-                                                   const std::string& what);
-
 }  // namespace tod

@@ -247,7 +247,7 @@ Status LoadOcclusionClassifier(const BundleFiles& files, ModelBundle& bundle) {
 }
 
 // The base edge source the manifest names: the trained pixel forest, the gradient, or SED.
-Status LoadEdgeSource(const BundleFiles& files, ModelBundle& bundle) {
+Status LoadBaseEdgeSource(const BundleFiles& files, ModelBundle& bundle) {
   if (bundle.edge_kind == "pixel_forest") {
     auto loaded = files.Decoded<PixelEdgeClassifier>(kEdgesFile);
     if (!loaded.ok()) return loaded.status();
@@ -278,7 +278,7 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
   if (!files.ok()) return files.status();
   ModelBundle bundle;
   for (const auto step :
-       {ReadManifestFields, LoadRegressors, LoadOcclusionClassifier, LoadEdgeSource}) {
+       {ReadManifestFields, LoadRegressors, LoadOcclusionClassifier, LoadBaseEdgeSource}) {
     if (Status st = step(*files, bundle); !st.ok()) return st;
   }
   return bundle;

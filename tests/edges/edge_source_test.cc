@@ -104,26 +104,5 @@ TEST(SedEdgeSource, YamlWithoutModelFieldsIsAnError) {
   std::filesystem::remove(path);
 }
 
-TEST(LoadEdgeSource, BuildsGradientAndRejectsUnknownKinds) {
-  const auto gradient = LoadEdgeSource("gradient", nullptr, "bundle");
-  ASSERT_TRUE(gradient.ok());
-  EXPECT_EQ((*gradient)->kind(), "gradient");
-
-  const auto unknown = LoadEdgeSource("canny", nullptr, "bundle.tod");
-  ASSERT_FALSE(unknown.ok());
-  EXPECT_NE(unknown.status().message().find("canny"), std::string::npos);
-
-  const auto no_stream = LoadEdgeSource("pixel_forest", nullptr, "bundle.tod");
-  EXPECT_FALSE(no_stream.ok());
-
-  BinaryReader junk("definitely not a model", "bundle.tod");
-  const auto bad_model = LoadEdgeSource("pixel_forest", &junk, "bundle.tod");
-  ASSERT_FALSE(bad_model.ok());
-  EXPECT_NE(bad_model.status().message().find("bundle.tod"), std::string::npos);
-
-  const auto sed = LoadEdgeSource("sed", nullptr, TempPath("missing.yml"));
-  EXPECT_EQ(sed.status().code(), StatusCode::kNotFound);
-}
-
 }  // namespace
 }  // namespace tod

@@ -154,6 +154,30 @@ TEST_F(ModelBundleTest, WrongFormatVersionAndBrokenManifestAreRefused) {
   EXPECT_NE(loaded.status().message().find("manifest.json"), std::string::npos);
 }
 
+// The manifest's edge_source decides the base edge source: an unknown kind is named, and a
+// "sed" bundle without its model file is refused, never loaded with another source.
+TEST_F(ModelBundleTest, UnknownEdgeSourceAndMissingSedModelAreRefused) {
+  ASSERT_TRUE(SaveModelBundle(SmallBundle(1), Path()).ok());
+  auto loaded = LoadModelBundle(Path());
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  EXPECT_EQ(loaded->edges->kind(), "gradient");
+  const fs::path manifest = fs::path(Path()) / "manifest.json";
+  std::ifstream in(manifest);
+  nlohmann::json j = nlohmann::json::parse(in);
+  in.close();
+  j["edge_source"] = "canny";
+  std::ofstream(manifest) << j.dump();
+  loaded = LoadModelBundle(Path());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(loaded.status().message().find("canny"), std::string::npos);
+  j["edge_source"] = "sed";
+  std::ofstream(manifest) << j.dump();
+  loaded = LoadModelBundle(Path());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.status().message().find("sed_model.yml.gz"), std::string::npos);
+}
+
 TEST_F(ModelBundleTest, MissingDirectory) {
   auto loaded = LoadModelBundle(Path("nowhere"));
   ASSERT_FALSE(loaded.ok());
