@@ -20,15 +20,16 @@
 
 namespace tod::cli {
 
-Runner AddDetectCommand(CLI::App& app) {
-  struct Args {
-    std::string model, out;
-    std::vector<std::string> images;
-    DetectOptions options;
-    bool stages = false;
-  };
-  auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("detect", "find obstacles in images");
+namespace {
+
+struct DetectArgs {
+  std::string model, out;
+  std::vector<std::string> images;
+  DetectOptions options;
+  bool stages = false;
+};
+
+void AddDetectOptions(CLI::App* cmd, const std::shared_ptr<DetectArgs>& args) {
   cmd->add_option("--model", args->model, "model bundle directory")->required();
   cmd->add_option("--out", args->out, "output directory")->required();
   cmd->add_option("images", args->images, "image files (PNG, JPEG)")->required();
@@ -50,6 +51,74 @@ Runner AddDetectCommand(CLI::App& app) {
   cmd->add_flag(
       "--stages", args->stages,
       "also write each stage as PNG (STEM_stage_*.png) and its counts (STEM_stages.json)");
+}
+
+// The frame budget counts from decoding, as in tod_server and tod bench: what the decode took
+// is taken off it.
+DetectOptions OptionsAfterDecode(DetectOptions options,
+                                 std::chrono::steady_clock::time_point read_start) {
+  if (options.budget_ms <= 0) return options;
+  const double decode_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - read_start)
+          .count();
+  options.budget_ms = std::max(1.0, options.budget_ms - decode_ms);
+  return options;
+}
+
+// STEM.json, STEM_prob.png, STEM_overlay.png and, with a stage bundle, the stage pictures.
+Status WriteDetectOutputs(const std::filesystem::path& base, const std::string& path,
+                          const cv::Mat3b& image, const Detection& detection,
+                          const std::optional<ModelBundle>& stage_bundle) {
+  Status st =
+      WriteFileAtomically(base.string() + ".json", DetectionToJson(detection, path).dump(2) + "\n");
+  if (st.ok())
+    st = WritePngAtomically(base.string() + "_prob.png", ProbabilityTo8Bit(detection.probability));
+  if (st.ok())
+    st = WritePngAtomically(base.string() + "_overlay.png", DrawOverlay(image, detection));
+  if (!st.ok() || !stage_bundle) return st;
+  auto stages = RenderStageImages(*stage_bundle, image);
+  if (!stages.ok()) return stages.status();
+  stages->counts["image"] = path;
+  return WriteStageImages(*stages, base.string());
+}
+
+// One image file. A frame that cannot be read or detected is reported and counted in
+// `failures` (the run goes on with the next); a failed write ends the run.
+Status DetectFile(const Detector& detector, const std::optional<ModelBundle>& stage_bundle,
+                  const DetectArgs& args, const std::string& path, int& failures) {
+  const auto read_start = std::chrono::steady_clock::now();
+  // Decoded as tod_server and tod bench decode (plain PNGs without libpng).
+  const Result<cv::Mat> read = ReadImageFile(path, cv::IMREAD_COLOR, "image");
+  if (!read.ok()) {
+    std::cerr << "tod: " << path << ": not a readable image (" << read.status().message() << ")\n";
+    ++failures;
+    return Status::Ok();
+  }
+  const cv::Mat& image = *read;
+  auto detection = detector.Detect(image, OptionsAfterDecode(args.options, read_start));
+  if (!detection.ok()) {
+    std::cerr << "tod: " << path << ": " << detection.status().message() << "\n";
+    ++failures;
+    return Status::Ok();
+  }
+  const std::string stem = std::filesystem::path(path).stem().string();
+  const std::filesystem::path base = std::filesystem::path(args.out) / stem;
+  if (Status st = WriteDetectOutputs(base, path, image, *detection, stage_bundle); !st.ok())
+    return st;
+  double total = 0;
+  for (const auto& [stage, ms] : detection->timings) total += ms;
+  std::cout << path << ": " << detection->obstacles.size() << " obstacles, "
+            << detection->proposals.size() << " proposals listed, " << static_cast<int>(total)
+            << " ms -> " << base.string() << "{.json,_prob.png,_overlay.png"
+            << (stage_bundle ? ",_stage_*.png,_stages.json" : "") << "}\n";
+  return Status::Ok();
+}
+
+}  // namespace
+
+Runner AddDetectCommand(CLI::App& app) {
+  auto args = std::make_shared<DetectArgs>();
+  AddDetectOptions(app.add_subcommand("detect", "find obstacles in images"), args);
   return [args] {
     UseRequestThreadsForOpenCv(args->options);
     auto detector = Detector::Load(args->model);
@@ -70,51 +139,8 @@ Runner AddDetectCommand(CLI::App& app) {
     if (ec) return Fail("cannot create " + args->out + ": " + ec.message());
     int failures = 0;
     for (const std::string& path : args->images) {
-      const auto read_start = std::chrono::steady_clock::now();
-      // Decoded as tod_server and tod bench decode (plain PNGs without libpng).
-      const Result<cv::Mat> read = ReadImageFile(path, cv::IMREAD_COLOR, "image");
-      if (!read.ok()) {
-        std::cerr << "tod: " << path << ": not a readable image (" << read.status().message()
-                  << ")\n";
-        ++failures;
-        continue;
-      }
-      const cv::Mat& image = *read;
-      // The frame budget counts from decoding, as in tod_server and tod bench.
-      DetectOptions options = args->options;
-      if (options.budget_ms > 0) {
-        const double decode_ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - read_start)
-                .count();
-        options.budget_ms = std::max(1.0, options.budget_ms - decode_ms);
-      }
-      auto detection = (*detector)->Detect(image, options);
-      if (!detection.ok()) {
-        std::cerr << "tod: " << path << ": " << detection.status().message() << "\n";
-        ++failures;
-        continue;
-      }
-      const std::string stem = std::filesystem::path(path).stem().string();
-      const std::filesystem::path base = std::filesystem::path(args->out) / stem;
-      Status st = WriteFileAtomically(base.string() + ".json",
-                                      DetectionToJson(*detection, path).dump(2) + "\n");
-      if (st.ok())
-        st = WritePngAtomically(base.string() + "_prob.png",
-                                ProbabilityTo8Bit(detection->probability));
-      if (st.ok())
-        st = WritePngAtomically(base.string() + "_overlay.png", DrawOverlay(image, *detection));
-      if (st.ok() && stage_bundle) {
-        auto stages = RenderStageImages(*stage_bundle, image);
-        if (stages.ok()) stages->counts["image"] = path;
-        st = stages.ok() ? WriteStageImages(*stages, base.string()) : stages.status();
-      }
+      const Status st = DetectFile(**detector, stage_bundle, *args, path, failures);
       if (!st.ok()) return Fail(st.message());
-      double total = 0;
-      for (const auto& [stage, ms] : detection->timings) total += ms;
-      std::cout << path << ": " << detection->obstacles.size() << " obstacles, "
-                << detection->proposals.size() << " proposals listed, " << static_cast<int>(total)
-                << " ms -> " << base.string() << "{.json,_prob.png,_overlay.png"
-                << (stage_bundle ? ",_stage_*.png,_stages.json" : "") << "}\n";
     }
     return failures == 0 ? 0 : 1;
   };
