@@ -204,37 +204,51 @@ std::vector<size_t> LocalMaxima(const std::vector<ScoreWindow>& hits, const std:
   return kept;
 }
 
-// One scan of the grid, refinement and NMS, keeping only grid windows that score above `bar`
-// (all with at least min_score when bar < 0). Sets *settled to whether the result is the one
-// the scan without a bar gives (always when bar < 0), see ScanWindowGrid.
-std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams& params,
-                                   EdgeBoxStats& stats, const WindowAdmission* admission, float bar,
-                                   bool* settled) {
-  const int threads = ResolveThreadCount(params.threads);
-  const float refine_ratio = (1.f - params.alpha) / (1.f + params.alpha);
-  const std::vector<WindowShape> shapes = WindowShapes(scorer.width(), scorer.height(), params);
+// The grid's columns, one per window shape and column position, and the window tops the size
+// filter admits in them.
+struct ScanGrid {
+  std::vector<WindowShape> shapes;
   std::vector<GridColumn> columns;
-  for (int s = 0; s < static_cast<int>(shapes.size()); ++s) {
-    // Same bounds as the grid definition: the last window may overhang and is clamped.
-    const int x_end = scorer.width() - shapes[s].width + shapes[s].stride_x;
-    for (int x = 0; x < x_end; x += shapes[s].stride_x) columns.push_back({s, x});
-  }
-  // Window tops the size filter admits for a column at x of a shape: from the column's clamped
-  // width and how far refinement can move the window's sides.
-  const auto admitted_tops_of = [&](int x, const WindowShape& shape) {
-    const int c0 = std::min(x, scorer.width() - 1);
-    const int c1 = std::min(x + shape.width, scorer.width() - 1);
-    const RefinementSchedule schedule = ScheduleRefinement(shape.height, c1 - c0, refine_ratio);
-    const RefinementReach reach =
-        params.refine ? RefinementReach{schedule.row_reach, schedule.col_reach} : RefinementReach{};
-    return admission->AdmittedTops(c1 - c0 + 1, shape.height + 1, reach, scorer.height());
-  };
-  std::vector<RowRanges> shape_tops;  // per shape, for its unclamped columns
-  if (admission != nullptr) {
-    for (const WindowShape& shape : shapes) shape_tops.push_back(admitted_tops_of(0, shape));
-  }
+  std::vector<RowRanges> shape_tops;  // per shape, for its unclamped columns; empty: no filter
+};
 
-  // Pass 1: score every grid window (steps 4-6).
+// Window tops the size filter admits for a column at x of a shape: from the column's clamped
+// width and how far refinement can move the window's sides.
+RowRanges AdmittedTops(const BoxScorer& scorer, const EdgeBoxParams& params,
+                       const WindowAdmission& admission, int x, const WindowShape& shape) {
+  const float refine_ratio = (1.f - params.alpha) / (1.f + params.alpha);
+  const int c0 = std::min(x, scorer.width() - 1);
+  const int c1 = std::min(x + shape.width, scorer.width() - 1);
+  const RefinementSchedule schedule = ScheduleRefinement(shape.height, c1 - c0, refine_ratio);
+  const RefinementReach reach =
+      params.refine ? RefinementReach{schedule.row_reach, schedule.col_reach} : RefinementReach{};
+  return admission.AdmittedTops(c1 - c0 + 1, shape.height + 1, reach, scorer.height());
+}
+
+ScanGrid MakeScanGrid(const BoxScorer& scorer, const EdgeBoxParams& params,
+                      const WindowAdmission* admission) {
+  ScanGrid grid;
+  grid.shapes = WindowShapes(scorer.width(), scorer.height(), params);
+  for (int s = 0; s < static_cast<int>(grid.shapes.size()); ++s) {
+    // Same bounds as the grid definition: the last window may overhang and is clamped.
+    const WindowShape& shape = grid.shapes[s];
+    const int x_end = scorer.width() - shape.width + shape.stride_x;
+    for (int x = 0; x < x_end; x += shape.stride_x) grid.columns.push_back({s, x});
+  }
+  if (admission != nullptr) {
+    for (const WindowShape& shape : grid.shapes) {
+      grid.shape_tops.push_back(AdmittedTops(scorer, params, *admission, 0, shape));
+    }
+  }
+  return grid;
+}
+
+// Pass 1: scores every grid window above `bar` (steps 4-6), column chunks on `threads` threads,
+// and returns the hits in grid order.
+GridHits ScanColumns(const BoxScorer& scorer, const EdgeBoxParams& params, const ScanGrid& grid,
+                     const WindowAdmission* admission, float bar, int threads,
+                     EdgeBoxStats& stats) {
+  const std::vector<GridColumn>& columns = grid.columns;
   const size_t column_chunks = (columns.size() + kColumnsPerChunk - 1) / kColumnsPerChunk;
   std::vector<ColumnChunk> scanned(column_chunks);
   std::vector<WorkerHits> found(static_cast<size_t>(std::max(1, threads)));
@@ -248,12 +262,13 @@ std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams&
         const size_t end = std::min(columns.size(), (c + 1) * kColumnsPerChunk);
         const long long walks_before = s.past_early_exit();
         for (size_t i = c * kColumnsPerChunk; i < end; ++i) {
-          const WindowShape& shape = shapes[columns[i].shape];
+          const WindowShape& shape = grid.shapes[columns[i].shape];
           // Tops admitted for this column: the shape's own unless the column is clamped narrower.
-          const RowRanges* tops = admission != nullptr ? &shape_tops[columns[i].shape] : nullptr;
+          const RowRanges* tops =
+              admission != nullptr ? &grid.shape_tops[columns[i].shape] : nullptr;
           RowRanges clamped_tops;
           if (tops != nullptr && columns[i].x + shape.width > s.width() - 1) {
-            clamped_tops = admitted_tops_of(columns[i].x, shape);
+            clamped_tops = AdmittedTops(scorer, params, *admission, columns[i].x, shape);
             tops = &clamped_tops;
           }
           const size_t before = own.hits.size();
@@ -266,46 +281,59 @@ std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams&
       });
   stats.scorings += scan.walks;
   if (scan.skipped > 0) stats.truncated = true;
-  GridHits grid = GatherInGridOrder(scanned, found, column_hits, stats);
-  found = {};
-  std::vector<ScoreWindow>& hits = grid.hits;
-  const std::vector<int>& hit_rows = grid.rows;
-  const std::vector<size_t>& column_begin = grid.column_begin;
+  return GatherInGridOrder(scanned, found, column_hits, stats);
+}
 
-  // Pass 2: refinement (step 7) in grid order - neighbouring windows share cache lines, which
-  // matters more than anything an order by score bounds could skip - then NMS (step 8).
-  if (params.refine) {
-    // Local maxima first, so that refine_limit picks the best of them.
-    std::vector<size_t> chosen;
-    if (params.refine_local_maxima) {
-      chosen = LocalMaxima(hits, hit_rows, column_begin, columns);
-    } else {
-      chosen.resize(hits.size());
-      std::iota(chosen.begin(), chosen.end(), size_t{0});
-    }
-    // With a bar, the refined windows are those of the unbarred scan only if the bar removed
-    // none of them: when at least refine_limit local maxima remain (every removed window scores
-    // below every remaining one, and removing lower windows keeps the others' local maximality).
-    if (bar >= 0.f && chosen.size() < static_cast<size_t>(params.refine_limit)) *settled = false;
-    chosen = BestByGridScore(hits, std::move(chosen), params.refine_limit);
-    const size_t chunks = (chosen.size() + kRefinementsPerChunk - 1) / kRefinementsPerChunk;
-    std::atomic<long long> refined_windows{0};
-    const ChunkRun refined = ParallelChunks(
-        scorer, chunks, threads, params.deadline, [&](BoxScorer& s, size_t, size_t c) {
-          const size_t end = std::min(chosen.size(), (c + 1) * kRefinementsPerChunk);
-          for (size_t i = c * kRefinementsPerChunk; i < end; ++i) s.Refine(hits[chosen[i]]);
-          refined_windows += static_cast<long long>(end - c * kRefinementsPerChunk);
-        });
-    stats.scorings += refined.walks;
-    stats.windows_refined = refined_windows.load();
-    if (refined.skipped > 0) {
-      stats.truncated = true;
-      stats.refinements_skipped = static_cast<long long>(chosen.size()) - stats.windows_refined;
-    }
+// Pass 2: refinement (step 7) of the best refine_limit local maxima (or every hit), in grid
+// order - neighbouring windows share cache lines, which matters more than anything an order by
+// score bounds could skip. Clears *settled when the bar may have removed a window the unbarred
+// scan would refine.
+void RefineHits(const BoxScorer& scorer, const EdgeBoxParams& params,
+                const std::vector<GridColumn>& columns, float bar, int threads, GridHits& grid,
+                EdgeBoxStats& stats, bool* settled) {
+  std::vector<ScoreWindow>& hits = grid.hits;
+  // Local maxima first, so that refine_limit picks the best of them.
+  std::vector<size_t> chosen;
+  if (params.refine_local_maxima) {
+    chosen = LocalMaxima(hits, grid.rows, grid.column_begin, columns);
+  } else {
+    chosen.resize(hits.size());
+    std::iota(chosen.begin(), chosen.end(), size_t{0});
   }
+  // With a bar, the refined windows are those of the unbarred scan only if the bar removed
+  // none of them: when at least refine_limit local maxima remain (every removed window scores
+  // below every remaining one, and removing lower windows keeps the others' local maximality).
+  if (bar >= 0.f && chosen.size() < static_cast<size_t>(params.refine_limit)) *settled = false;
+  chosen = BestByGridScore(hits, std::move(chosen), params.refine_limit);
+  const size_t chunks = (chosen.size() + kRefinementsPerChunk - 1) / kRefinementsPerChunk;
+  std::atomic<long long> refined_windows{0};
+  const ChunkRun refined =
+      ParallelChunks(scorer, chunks, threads, params.deadline, [&](BoxScorer& s, size_t, size_t c) {
+        const size_t end = std::min(chosen.size(), (c + 1) * kRefinementsPerChunk);
+        for (size_t i = c * kRefinementsPerChunk; i < end; ++i) s.Refine(hits[chosen[i]]);
+        refined_windows += static_cast<long long>(end - c * kRefinementsPerChunk);
+      });
+  stats.scorings += refined.walks;
+  stats.windows_refined = refined_windows.load();
+  if (refined.skipped > 0) {
+    stats.truncated = true;
+    stats.refinements_skipped = static_cast<long long>(chosen.size()) - stats.windows_refined;
+  }
+}
+
+// One scan of the grid, refinement and NMS (step 8), keeping only grid windows that score above
+// `bar` (all with at least min_score when bar < 0). Sets *settled to whether the result is the
+// one the scan without a bar gives (always when bar < 0), see ScanWindowGrid.
+std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams& params,
+                                   EdgeBoxStats& stats, const WindowAdmission* admission, float bar,
+                                   bool* settled) {
+  const int threads = ResolveThreadCount(params.threads);
+  const ScanGrid grid = MakeScanGrid(scorer, params, admission);
+  GridHits hits = ScanColumns(scorer, params, grid, admission, bar, threads, stats);
+  if (params.refine) RefineHits(scorer, params, grid.columns, bar, threads, hits, stats, settled);
   std::vector<ScoredBox> boxes;
-  boxes.reserve(hits.size());
-  for (const ScoreWindow& w : hits) boxes.push_back(ScoredBox{ToBox(w), w.score});
+  boxes.reserve(hits.hits.size());
+  for (const ScoreWindow& w : hits.hits) boxes.push_back(ScoredBox{ToBox(w), w.score});
   hits = {};
   std::vector<ScoredBox> kept =
       NonMaximumSuppression(std::move(boxes), params.beta, params.max_boxes);
