@@ -123,41 +123,48 @@ int VerticalRangeIndex(int row, const std::vector<int>& range_limits) {
   return std::max(0, num_ranges - 1);  // the closed top range and everything above it
 }
 
-Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& proposals,
-                                              const Sample& gt,
-                                              const std::vector<int>& range_limits,
-                                              const SampleSelectionParams& params,
-                                              std::uint64_t seed) {
-  if (Status s = ValidateSelectionInput(gt, range_limits, params); !s.ok()) return s;
-  Result<MaskIoUTable> table = MaskIoUTable::Build(gt.instances);
-  if (!table.ok()) {
-    return Status::InvalidArgument("SelectTrainingSamples(sample '" + gt.name +
-                                   "'): " + table.status().message());
-  }
-  const MaskIoUTable& obstacles = *table;
+namespace {
+
+// What selection needs of each proposal: its best mask IoU with an obstacle, its category and
+// its vertical range.
+struct ProposalLabels {
+  std::vector<double> max_iou;
+  std::vector<ProposalCategory> category;
+  std::vector<int> range;
+};
+
+ProposalLabels LabelProposals(const std::vector<ScoredBox>& proposals, const Sample& gt,
+                              const MaskIoUTable& obstacles, const std::vector<int>& range_limits,
+                              const SampleSelectionParams& params) {
   const MaskPixelCounter road(gt.road);
   const MaskPixelCounter void_pixels =
       gt.ignore.empty() ? MaskPixelCounter() : MaskPixelCounter(gt.ignore);
-  const int num_proposals = static_cast<int>(proposals.size());
-
-  std::vector<double> max_iou(num_proposals);
-  std::vector<ProposalCategory> category(num_proposals);
-  std::vector<int> range(num_proposals);
-  for (int i = 0; i < num_proposals; ++i) {
-    const Box& box = proposals[i].box;
-    max_iou[i] = obstacles.MaxIoU(box);
-    category[i] = CategorizeProposal(box, obstacles, road, void_pixels, params);
-    range[i] = VerticalRangeIndex(BottomRow(box), range_limits);
+  ProposalLabels labels;
+  labels.max_iou.reserve(proposals.size());
+  labels.category.reserve(proposals.size());
+  labels.range.reserve(proposals.size());
+  for (const ScoredBox& proposal : proposals) {
+    const Box& box = proposal.box;
+    labels.max_iou.push_back(obstacles.MaxIoU(box));
+    labels.category.push_back(CategorizeProposal(box, obstacles, road, void_pixels, params));
+    labels.range.push_back(VerticalRangeIndex(BottomRow(box), range_limits));
   }
+  return labels;
+}
 
-  SelectedSamples out;
-  // Positives: per GT obstacle, the n+_k proposals of all of B^I with the highest IoU to it
-  // (IoU > 0), k = range of the obstacle's bottom; ties keep the lower proposal index.
-  std::vector<char> is_positive(num_proposals, 0);
+// Positives: per GT obstacle, the n+_k proposals of all of B^I with the highest IoU to it
+// (IoU > 0), k = range of the obstacle's bottom; ties keep the lower proposal index. In order of
+// the obstacles, each proposal once.
+std::vector<int> SelectPositives(const std::vector<ScoredBox>& proposals, const Sample& gt,
+                                 const MaskIoUTable& obstacles,
+                                 const std::vector<int>& range_limits,
+                                 const SampleSelectionParams& params) {
+  std::vector<int> positives;
+  std::vector<char> is_positive(proposals.size(), 0);
   for (int o = 0; o < obstacles.num_instances(); ++o) {
     const int k = VerticalRangeIndex(BottomRow(gt.instances[o].box), range_limits);
     std::vector<std::pair<double, int>> overlapping;  // (IoU, proposal index)
-    for (int i = 0; i < num_proposals; ++i) {
+    for (int i = 0; i < static_cast<int>(proposals.size()); ++i) {
       const double iou = obstacles.IoU(proposals[i].box, o);
       if (iou > 0.0) overlapping.emplace_back(iou, i);
     }
@@ -171,73 +178,120 @@ Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& prop
       const int index = overlapping[j].second;
       if (!is_positive[index]) {
         is_positive[index] = 1;
-        out.positive_indices.push_back(index);
+        positives.push_back(index);
       }
     }
   }
+  return positives;
+}
 
-  std::mt19937_64 rng(seed);
-  const int num_ranges = static_cast<int>(range_limits.size()) - 1;
-  // Each bag draws from what the earlier bags left, so the bags are disjoint.
-  std::vector<char> drawn_before(num_proposals, 0);
-  const auto select_negatives = [&](ProposalCategory wanted, const std::vector<int>& counts) {
+// Draws the negatives of one regressor after another from one random stream, so that the draws
+// depend only on the seed and the order of the calls.
+class NegativeSampler {
+ public:
+  NegativeSampler(const std::vector<ScoredBox>& proposals, const ProposalLabels& labels,
+                  const std::vector<int>& positives, int num_ranges,
+                  const SampleSelectionParams& params, std::uint64_t seed)
+      : proposals_(proposals),
+        labels_(labels),
+        num_ranges_(num_ranges),
+        params_(params),
+        rng_(seed),
+        is_positive_(proposals.size(), 0),
+        drawn_before_(proposals.size(), 0) {
+    for (const int i : positives) is_positive_[i] = 1;
+  }
+
+  // The negatives of `wanted` of every bag, in bag order; `bags` gets kEveryBag for each of the
+  // `positives` positives and then the bag of each negative. Each bag draws from what the
+  // earlier bags left, so the bags are disjoint.
+  std::vector<int> DrawBags(ProposalCategory wanted, const std::vector<int>& counts,
+                            std::size_t positives, std::vector<int>& bags) {
+    std::fill(drawn_before_.begin(), drawn_before_.end(), 0);
     std::vector<int> negatives;
-    for (int k = 0; k < num_ranges; ++k) {
-      std::vector<int> hard, easy;
-      for (int i = 0; i < num_proposals; ++i) {
-        if (range[i] != k || category[i] != wanted || is_positive[i] || drawn_before[i] ||
-            max_iou[i] >= params.obstacle_iou) {
-          continue;
-        }
-        (proposals[i].score > params.hard_objectness ? hard : easy).push_back(i);
-      }
-      const std::vector<int> drawn =
-          DrawNegatives(hard, easy, counts[k], params.hard_fraction, rng);
-      negatives.insert(negatives.end(), drawn.begin(), drawn.end());
-    }
-    for (int i : negatives) drawn_before[i] = 1;
-    return negatives;
-  };
-  // The negatives of every bag, in bag order, with the bag of each.
-  const auto select_bags = [&](ProposalCategory wanted, const std::vector<int>& counts,
-                               std::vector<int>& bags) {
-    std::fill(drawn_before.begin(), drawn_before.end(), 0);
-    std::vector<int> negatives;
-    bags.assign(out.positive_indices.size(), SelectedSamples::kEveryBag);
-    for (int bag = 0; bag < params.negative_bags; ++bag) {
-      const std::vector<int> drawn = select_negatives(wanted, counts);
+    bags.assign(positives, SelectedSamples::kEveryBag);
+    for (int bag = 0; bag < params_.negative_bags; ++bag) {
+      const std::vector<int> drawn = DrawOneBag(wanted, counts);
       negatives.insert(negatives.end(), drawn.begin(), drawn.end());
       bags.insert(bags.end(), drawn.size(), bag);
     }
     return negatives;
-  };
+  }
 
-  const auto target_of = [&](int i) {
-    return static_cast<float>(params.box_iou_target ? obstacles.MaxBoxIoU(proposals[i].box)
-                                                    : max_iou[i]);
-  };
+ private:
+  // Per vertical range k, counts[k] negatives of `wanted`, hard ones (objectness above
+  // hard_objectness) and easy ones as DrawNegatives shares them.
+  std::vector<int> DrawOneBag(ProposalCategory wanted, const std::vector<int>& counts) {
+    std::vector<int> negatives;
+    for (int k = 0; k < num_ranges_; ++k) {
+      std::vector<int> hard, easy;
+      for (int i = 0; i < static_cast<int>(proposals_.size()); ++i) {
+        if (labels_.range[i] != k || labels_.category[i] != wanted || is_positive_[i] ||
+            drawn_before_[i] || labels_.max_iou[i] >= params_.obstacle_iou) {
+          continue;
+        }
+        (proposals_[i].score > params_.hard_objectness ? hard : easy).push_back(i);
+      }
+      const std::vector<int> drawn =
+          DrawNegatives(hard, easy, counts[k], params_.hard_fraction, rng_);
+      negatives.insert(negatives.end(), drawn.begin(), drawn.end());
+    }
+    for (const int i : negatives) drawn_before_[i] = 1;
+    return negatives;
+  }
+
+  const std::vector<ScoredBox>& proposals_;
+  const ProposalLabels& labels_;
+  const int num_ranges_;
+  const SampleSelectionParams& params_;
+  std::mt19937_64 rng_;
+  std::vector<char> is_positive_;
+  std::vector<char> drawn_before_;
+};
+
+}  // namespace
+
+Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& proposals,
+                                              const Sample& gt,
+                                              const std::vector<int>& range_limits,
+                                              const SampleSelectionParams& params,
+                                              std::uint64_t seed) {
+  if (Status s = ValidateSelectionInput(gt, range_limits, params); !s.ok()) return s;
+  Result<MaskIoUTable> table = MaskIoUTable::Build(gt.instances);
+  if (!table.ok()) {
+    return Status::InvalidArgument("SelectTrainingSamples(sample '" + gt.name +
+                                   "'): " + table.status().message());
+  }
+  const MaskIoUTable& obstacles = *table;
+  const ProposalLabels labels = LabelProposals(proposals, gt, obstacles, range_limits, params);
+  SelectedSamples out;
+  out.positive_indices = SelectPositives(proposals, gt, obstacles, range_limits, params);
+
   const auto assemble = [&](const std::vector<int>& negatives, std::vector<int>& indices,
                             std::vector<float>& targets) {
     indices = out.positive_indices;
     indices.insert(indices.end(), negatives.begin(), negatives.end());
     targets.reserve(indices.size());
-    for (const int i : indices) targets.push_back(target_of(i));
+    for (const int i : indices) {
+      targets.push_back(static_cast<float>(
+          params.box_iou_target ? obstacles.MaxBoxIoU(proposals[i].box) : labels.max_iou[i]));
+    }
   };
-  if (gt.free_space == FreeSpace::kNotObstacle) {
-    // No road label (obstacle-mask benchmarks): road and background cannot be told apart, so
-    // every non-obstacle proposal is category (i) and OBDR draws its negatives, independently of
-    // ORDR's, from the same pool. The two regressors then differ by their samples only, and the
-    // fusion acts as a two-member ensemble instead of adding a background expert.
-    // (The two draws are independent: a proposal may be a negative of both.)
-    assemble(select_bags(ProposalCategory::kRoad, params.ordr_negatives, out.ordr_bags),
-             out.ordr_indices, out.ordr_targets);
-    assemble(select_bags(ProposalCategory::kRoad, params.obdr_negatives, out.obdr_bags),
-             out.obdr_indices, out.obdr_targets);
-    return out;
-  }
-  assemble(select_bags(ProposalCategory::kRoad, params.ordr_negatives, out.ordr_bags),
-           out.ordr_indices, out.ordr_targets);
-  assemble(select_bags(ProposalCategory::kBackground, params.obdr_negatives, out.obdr_bags),
+  // No road label (obstacle-mask benchmarks): road and background cannot be told apart, so
+  // every non-obstacle proposal is category (i) and OBDR draws its negatives, independently of
+  // ORDR's, from the same pool. The two regressors then differ by their samples only, and the
+  // fusion acts as a two-member ensemble instead of adding a background expert.
+  // (The two draws are independent: a proposal may be a negative of both.)
+  const ProposalCategory obdr_pool = gt.free_space == FreeSpace::kNotObstacle
+                                         ? ProposalCategory::kRoad
+                                         : ProposalCategory::kBackground;
+  NegativeSampler sampler(proposals, labels, out.positive_indices,
+                          static_cast<int>(range_limits.size()) - 1, params, seed);
+  const std::size_t positives = out.positive_indices.size();
+  assemble(
+      sampler.DrawBags(ProposalCategory::kRoad, params.ordr_negatives, positives, out.ordr_bags),
+      out.ordr_indices, out.ordr_targets);
+  assemble(sampler.DrawBags(obdr_pool, params.obdr_negatives, positives, out.obdr_bags),
            out.obdr_indices, out.obdr_targets);
   return out;
 }
