@@ -50,6 +50,51 @@ double EffectiveBudgetMs(double server_ms, double request_ms) {
   return std::min(server_ms, request_ms);
 }
 
+// The refusal for an image that did not decode: too large, or not an image.
+InferenceResult DecodeRefusal(const Status& status) {
+  const Rejection why =
+      status.code() == StatusCode::kResourceExhausted ? Rejection::kTooLarge : Rejection::kBadImage;
+  return Refusal(status, why);
+}
+
+// The pipeline's options for a request: its own, the server's threads per request, and the
+// frame budget (the server's, lowered by the request's) less what decoding already spent.
+DetectOptions PipelineOptions(const InferenceRequest& request, const EngineConfig& config,
+                              std::chrono::steady_clock::time_point started) {
+  DetectOptions options = request.options;
+  options.want_probability_map = request.encode_map_png;
+  options.threads = config.threads_per_request;
+  options.budget_ms = EffectiveBudgetMs(config.frame_budget_ms, request.options.budget_ms);
+  options.budget_ms = BudgetLeftMs(options.budget_ms, MillisecondsSince(started));
+  return options;
+}
+
+// Runs the detector into `detection`; what to answer instead when it stopped or failed. An
+// exception from the pipeline becomes this request's INTERNAL error, never the worker's end.
+std::optional<InferenceResult> RunDetector(const Detector& detector, const cv::Mat3b& image,
+                                           const DetectOptions& options,
+                                           const Cancellation& cancellation, const int& boundaries,
+                                           Detection& detection) {
+  try {
+    Result<Detection> run = detector.Detect(image, options);
+    if (const std::optional<CancelReason> reason = cancellation.reason(); !run.ok() && reason) {
+      return Stopped(*reason, "while the pipeline ran (at its stage boundary " +
+                                  std::to_string(boundaries) + ")");
+    }
+    if (!run.ok()) {
+      const Rejection why = run.status().code() == StatusCode::kInvalidArgument
+                                ? Rejection::kBadImage
+                                : Rejection::kInternal;
+      return Refusal(run.status(), why);
+    }
+    detection = std::move(*run);
+  } catch (const std::exception& e) {
+    return Refusal(Status::Internal(std::string("pipeline failed: ") + e.what()),
+                   Rejection::kInternal);
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 const char* RejectionName(Rejection rejection) {
@@ -243,48 +288,24 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
   const Clock::time_point started = Clock::now();  // the frame budget counts from here
   StageTimer timer;
   Result<cv::Mat3b> image = DecodeImage(request.image, config_.limits);
-  if (!image.ok()) {
-    const Rejection why = image.status().code() == StatusCode::kResourceExhausted
-                              ? Rejection::kTooLarge
-                              : Rejection::kBadImage;
-    return Refusal(image.status(), why);
-  }
+  if (!image.ok()) return DecodeRefusal(image.status());
   timer.Mark("decode");
   result.timings.insert(result.timings.end(), timer.times().begin(), timer.times().end());
   if (const std::optional<CancelReason> reason = StopReason(cancellation, request.deadline)) {
     return Stopped(*reason, "after decoding");
   }
 
-  DetectOptions options = request.options;
-  options.want_probability_map = request.encode_map_png;
-  options.threads = config_.threads_per_request;
-  options.budget_ms = EffectiveBudgetMs(config_.frame_budget_ms, request.options.budget_ms);
-  // Decoding already spent part of it.
-  options.budget_ms = BudgetLeftMs(options.budget_ms, MillisecondsSince(started));
+  DetectOptions options = PipelineOptions(request, config_, started);
   // Asked between the pipeline's stages; the Status it returns is only a signal here: the result
-  // is rebuilt from the reason below so the message says where the work stopped.
+  // is rebuilt from the reason (RunDetector) so the message says where the work stopped.
   int boundaries = 0;  // stage boundaries passed, for the message
   options.cancelled = [&cancellation, &request, &boundaries] {
     ++boundaries;
     return StopReason(cancellation, request.deadline) ? Status::Cancelled("stop") : Status::Ok();
   };
-  try {
-    Result<Detection> detection = result.model->detector->Detect(*image, options);
-    if (const std::optional<CancelReason> reason = cancellation.reason();
-        !detection.ok() && reason) {
-      return Stopped(*reason, "while the pipeline ran (at its stage boundary " +
-                                  std::to_string(boundaries) + ")");
-    }
-    if (!detection.ok()) {
-      const Rejection why = detection.status().code() == StatusCode::kInvalidArgument
-                                ? Rejection::kBadImage
-                                : Rejection::kInternal;
-      return Refusal(detection.status(), why);
-    }
-    result.detection = std::move(*detection);
-  } catch (const std::exception& e) {
-    return Refusal(Status::Internal(std::string("pipeline failed: ") + e.what()),
-                   Rejection::kInternal);
+  if (std::optional<InferenceResult> failed = RunDetector(
+          *result.model->detector, *image, options, cancellation, boundaries, result.detection)) {
+    return std::move(*failed);
   }
   result.timings.insert(result.timings.end(), result.detection.timings.begin(),
                         result.detection.timings.end());
