@@ -45,6 +45,17 @@ std::vector<ScoredBox> Reference(std::vector<ScoredBox> boxes, float thr, int ma
   return kept;
 }
 
+// NonMaximumSuppression keeps the boxes plain greedy NMS keeps, in its order, at every threshold.
+void ExpectSameAsPlainGreedyNms(const std::vector<ScoredBox>& boxes,
+                                std::initializer_list<float> thresholds) {
+  for (const float thr : thresholds) {
+    const auto expected = Reference(boxes, thr, 100000);
+    const auto got = NonMaximumSuppression(boxes, thr, 100000);
+    ASSERT_EQ(got.size(), expected.size()) << thr;
+    for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].box, expected[i].box) << thr << i;
+  }
+}
+
 TEST(NmsTest, BinnedNmsEqualsPlainGreedyNms) {
   std::mt19937 rng(3);
   std::uniform_int_distribution<int> pos(0, 40), size(1, 30), score(0, 50);
@@ -100,12 +111,7 @@ TEST(NmsTest, GridIndexEqualsPlainGreedyNmsOnWideRanges) {
   }
   boxes.push_back({{1000000000, -1000000000, 50, 50}, 3.f});
   boxes.push_back({{1000000002, -1000000001, 50, 51}, 2.f});  // IoU 0.92 with the one above
-  for (const float thr : {0.5f, 0.75f}) {
-    const auto expected = Reference(boxes, thr, 100000);
-    const auto got = NonMaximumSuppression(boxes, thr, 100000);
-    ASSERT_EQ(got.size(), expected.size()) << thr;
-    for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].box, expected[i].box) << thr << i;
-  }
+  ExpectSameAsPlainGreedyNms(boxes, {0.5f, 0.75f});
 }
 
 }  // namespace
@@ -129,12 +135,7 @@ TEST(NmsTest, GridIndexEqualsPlainGreedyNmsOnDenseSmallBoxes) {
                        score(rng)});
     }
   }
-  for (const float thr : {0.4f, 0.65f, 0.8f}) {
-    const auto expected = Reference(boxes, thr, 100000);
-    const auto got = NonMaximumSuppression(boxes, thr, 100000);
-    ASSERT_EQ(got.size(), expected.size()) << thr;
-    for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i].box, expected[i].box) << thr << i;
-  }
+  ExpectSameAsPlainGreedyNms(boxes, {0.4f, 0.65f, 0.8f});
 }
 
 }  // namespace
