@@ -14,23 +14,10 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& e
   const int width = edges.cols, height = edges.rows;
   const int n = groups.count();
   stride_ = static_cast<size_t>(height) + 1;
-  // Bounding boxes of the groups: every grouped pixel is an edge pixel, and the column-major
-  // list meets a group's columns in ascending order.
-  std::vector<int> x0(n + 1, width), x1(n + 1, -1), y0(n + 1, height), y1(n + 1, -1);
-  for (int c = 0; c < width; ++c) {
-    for (int i = edges.col_begin[c]; i < edges.col_begin[c + 1]; ++i) {
-      const int r = edges.col_row[i];
-      const int s = groups.ids(r, c);
-      if (s <= 0) continue;
-      if (x1[s] < 0) x0[s] = c;
-      x1[s] = c;
-      y0[s] = std::min(y0[s], r);
-      y1[s] = std::max(y1[s], r);
-    }
-  }
+  const std::vector<GroupBox> extents = GroupExtents(groups, edges);
   group_boxes_.reserve(n);
   for (int s = 1; s <= n; ++s)
-    if (x1[s] >= 0) group_boxes_.push_back({x0[s], x1[s], y0[s], y1[s]});
+    if (extents[s].c1 >= 0) group_boxes_.push_back(extents[s]);
   std::stable_sort(group_boxes_.begin(), group_boxes_.end(),
                    [](const GroupBox& a, const GroupBox& b) { return a.c0 < b.c0; });
   double total_magnitude = 0.0, total_edge = 0.0;
@@ -46,12 +33,39 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& e
   inverse_scale_ = 1.0 / scale;
   // The exact score is a handful of double operations on values up to the totals.
   margin_ = 1e-9 * (largest + 1.0);
-
   // Both integrals are built column by column (see fresh_buffer.h) as left column + running sum
   // of this column, in modular uint32 arithmetic: the ring's sums do not depend on the order of
   // the additions, so the values equal those of any other summation order (e.g. the 2-D
   // recurrence here = pixel + up + left - up_left).
-  const size_t size = (static_cast<size_t>(width) + 1) * stride_;
+  BuildCornerIntegral(groups, extents, scale, width, height);
+  BuildEdgeIntegral(edges, scale, width, height);
+}
+
+std::vector<ContainmentBound::GroupBox> ContainmentBound::GroupExtents(const EdgeGroups& groups,
+                                                                       const EdgePixels& edges) {
+  // Every grouped pixel is an edge pixel, and the column-major list meets a group's columns in
+  // ascending order.
+  std::vector<GroupBox> extents(static_cast<size_t>(groups.count()) + 1,
+                                GroupBox{edges.cols, -1, edges.rows, -1});
+  for (int c = 0; c < edges.cols; ++c) {
+    for (int i = edges.col_begin[c]; i < edges.col_begin[c + 1]; ++i) {
+      const int r = edges.col_row[i];
+      const int s = groups.ids(r, c);
+      if (s <= 0) continue;
+      GroupBox& g = extents[s];
+      if (g.c1 < 0) g.c0 = c;
+      g.c1 = c;
+      g.r0 = std::min(g.r0, r);
+      g.r1 = std::max(g.r1, r);
+    }
+  }
+  return extents;
+}
+
+void ContainmentBound::BuildCornerIntegral(const EdgeGroups& groups,
+                                           const std::vector<GroupBox>& extents, double scale,
+                                           int width, int height) {
+  const int n = groups.count();
   // Group magnitudes at the four bounding-box corners, bucketed by integral column.
   struct CornerValue {
     int row = 0, corner = 0;
@@ -59,21 +73,20 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& e
   };
   std::vector<int> corner_begin(static_cast<size_t>(width) + 2, 0);
   for (int s = 1; s <= n; ++s) {
-    corner_begin[x0[s] + 2] += 2;  // corners 0 and 2 in integral column x0 + 1
-    corner_begin[x1[s] + 2] += 2;  // corners 1 and 3 in integral column x1 + 1
+    corner_begin[extents[s].c0 + 2] += 2;  // corners 0 and 2 in integral column c0 + 1
+    corner_begin[extents[s].c1 + 2] += 2;  // corners 1 and 3 in integral column c1 + 1
   }
   for (int c = 0; c <= width; ++c) corner_begin[c + 1] += corner_begin[c];
   std::vector<CornerValue> corners(static_cast<size_t>(corner_begin[width + 1]));
-  {
-    std::vector<int> next(corner_begin.begin(), corner_begin.end() - 1);
-    for (int s = 1; s <= n; ++s) {
-      const auto q = static_cast<std::uint32_t>(std::ceil(groups.magnitude[s] * scale));
-      const int xs[4] = {x0[s], x1[s], x0[s], x1[s]};
-      const int ys[4] = {y0[s], y0[s], y1[s], y1[s]};
-      for (int k = 0; k < 4; ++k) corners[next[xs[k] + 1]++] = {ys[k] + 1, k, q};
-    }
+  std::vector<int> next(corner_begin.begin(), corner_begin.end() - 1);
+  for (int s = 1; s <= n; ++s) {
+    const GroupBox& g = extents[s];
+    const auto q = static_cast<std::uint32_t>(std::ceil(groups.magnitude[s] * scale));
+    const int xs[4] = {g.c0, g.c1, g.c0, g.c1};
+    const int ys[4] = {g.r0, g.r0, g.r1, g.r1};
+    for (int k = 0; k < 4; ++k) corners[next[xs[k] + 1]++] = {ys[k] + 1, k, q};
   }
-  ReserveFresh(cells_, size);
+  ReserveFresh(cells_, (static_cast<size_t>(width) + 1) * stride_);
   Append(cells_, stride_);  // column 0: zero
   for (int c = 1; c <= width; ++c) {
     Cell* here = Append(cells_, stride_);  // zeroed, cache-resident: scatter, then sum in place
@@ -93,9 +106,13 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& e
       here[r].corner[3] = left[r].corner[3] + sum3;
     }
   }
+}
+
+void ContainmentBound::BuildEdgeIntegral(const EdgePixels& edges, double scale, int width,
+                                         int height) {
   // The edge integral only changes at edge pixels: between two of them a column is the left
   // column plus a constant.
-  ReserveFresh(edges_, size);
+  ReserveFresh(edges_, (static_cast<size_t>(width) + 1) * stride_);
   Append(edges_, stride_);  // column 0: zero
   for (int c = 1; c <= width; ++c) {
     std::uint32_t* here = Append(edges_, stride_);  // row 0: zero

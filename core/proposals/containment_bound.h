@@ -145,16 +145,25 @@ class ContainmentBound {
     return v.inner_right[ir1 + 1] - v.inner_right[ir0] - v.inner_left[ir1 + 1] + v.inner_left[ir0];
   }
 
+  // A group's bounding box (inclusive).
+  struct GroupBox {
+    int c0 = 0, c1 = 0, r0 = 0, r1 = 0;
+  };
+  // The constructor's steps. Per group id (0 unused), its bounding box; c1 < 0 for a group
+  // without pixels.
+  static std::vector<GroupBox> GroupExtents(const EdgeGroups& groups, const EdgePixels& edges);
+  // cells_: the groups' magnitudes (times `scale`, rounded up) summed at their four corners.
+  void BuildCornerIntegral(const EdgeGroups& groups, const std::vector<GroupBox>& extents,
+                           double scale, int width, int height);
+  // edges_: the edge pixels' magnitudes (times `scale`, rounded down).
+  void BuildEdgeIntegral(const EdgePixels& edges, double scale, int width, int height);
+
   size_t stride_ = 0;
   double inverse_scale_ = 0.0;  // fixed point -> magnitude
   double margin_ = 0.0;         // covers the double rounding of the exact score
   std::vector<Cell> cells_;
-  std::vector<std::uint32_t> edges_;  // M where M > edge_min_mag, rounded down
-  // Every group's bounding box (inclusive), by first column.
-  struct GroupBox {
-    int c0 = 0, c1 = 0, r0 = 0, r1 = 0;
-  };
-  std::vector<GroupBox> group_boxes_;
+  std::vector<std::uint32_t> edges_;   // M where M > edge_min_mag, rounded down
+  std::vector<GroupBox> group_boxes_;  // the groups with pixels, by first column
 };
 
 }  // namespace tod
