@@ -186,11 +186,19 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
                                     region_size_.width, region_size_.height);
   if (local_box.empty()) return f;
   const cv::Rect r = local_box.rect();
+  AddEdgeFeatures(r, f);
+  AddPlaceFeatures(r, f);
+  AddColourSpread(r, f);
+  AddEdgeOrientation(r, f);
+  AddSurroundContrast(r, f);
+  return f;
+}
+
+// Features 1-7. Features 4-5 use the centre sub-box (half width, half height, same centre; the
+// code's "inner ring", ALGORITHM.md §10 #10), normalised by A/4 as in the original.
+void BoxFeatureExtractor::AddEdgeFeatures(const cv::Rect& r, BoxFeatureVector& f) const {
   const int w = r.width, h = r.height;
   const double area = static_cast<double>(w) * h;
-
-  // Features 1-7. Features 4-5 use the centre sub-box (half width, half height, same centre; the
-  // code's "inner ring", ALGORITHM.md §10 #10), normalised by A/4 as in the original.
   const int inner_w = w / 2, inner_h = h / 2;
   const cv::Rect inner(r.x + (w - inner_w) / 2, r.y + (h - inner_h) / 2, inner_w, inner_h);
   const BoxEdgeStats edges = edges_.Measure(r, inner);
@@ -201,8 +209,12 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
   f[4] = static_cast<float>(SafeDiv(edges.inner_count, area / 4.0));
   f[5] = static_cast<float>(edges.sum / area);
   f[6] = static_cast<float>(edges.count / area);
+}
 
-  // Features 8-9, 11-14: pseudodistance, normalised by the actual image size (§10 #23).
+// Features 8-9, 11-14: pseudodistance, normalised by the actual image size (§10 #23).
+void BoxFeatureExtractor::AddPlaceFeatures(const cv::Rect& r, BoxFeatureVector& f) const {
+  const int w = r.width, h = r.height;
+  const double area = static_cast<double>(w) * h;
   const double image_w = image_size_.width, image_h = image_size_.height;
   const int x_for_centre = options_.region_relative_centre ? r.x : r.x + origin_.x;
   const int y_for_centre = options_.region_relative_centre ? r.y : r.y + origin_.y;
@@ -224,27 +236,39 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
     f[12] = static_cast<float>(w / image_w);
     f[13] = static_cast<float>(h / image_h);
   }
+}
 
-  // Features 15-17: population standard deviation of H, S, V.
-  const cv::Point to_colour = region_in_colour_.tl();
-  cv::Rect box_in_colour(r.tl() + to_colour, r.size());
-  const ColourMoments moments = colour_->Moments(box_in_colour);
-  const cv::Rect box_in_vertical(r.tl() + region_in_vertical_, r.size());
-  if (options_.vertical_edges) f[20] = static_cast<float>(vertical_->Share(box_in_vertical));
-  if (options_.orientation_entropy)
-    f[options_.vertical_edges ? 21 : 20] =
-        static_cast<float>(vertical_->OrientationEntropy(box_in_vertical));
+// Features 15-17: population standard deviation of H, S, V.
+void BoxFeatureExtractor::AddColourSpread(const cv::Rect& r, BoxFeatureVector& f) const {
+  const double area = static_cast<double>(r.width) * r.height;
+  const ColourMoments moments =
+      colour_->Moments(cv::Rect(r.tl() + region_in_colour_.tl(), r.size()));
   for (int c = 0; c < 3; ++c) {
     const double mean = moments[c] / area;
     const double variance = moments[3 + c] / area - mean * mean;
     f[14 + c] = static_cast<float>(std::sqrt(std::max(0.0, variance)));
   }
+}
 
-  // Features 18-20: histogram of the box against its surround ring = (box grown by w/2 left and
-  // right, h/2 top and bottom, clipped to the region) minus the box.
+// The optional features after the paper's 20: the share of strong gradient on near-vertical
+// edges, then the orientation entropy.
+void BoxFeatureExtractor::AddEdgeOrientation(const cv::Rect& r, BoxFeatureVector& f) const {
+  const cv::Rect box_in_vertical(r.tl() + region_in_vertical_, r.size());
+  if (options_.vertical_edges) f[20] = static_cast<float>(vertical_->Share(box_in_vertical));
+  if (options_.orientation_entropy)
+    f[options_.vertical_edges ? 21 : 20] =
+        static_cast<float>(vertical_->OrientationEntropy(box_in_vertical));
+}
+
+// Features 18-20: histogram of the box against its surround ring = (box grown by w/2 left and
+// right, h/2 top and bottom, clipped to the region) minus the box.
+void BoxFeatureExtractor::AddSurroundContrast(const cv::Rect& r, BoxFeatureVector& f) const {
+  const int w = r.width, h = r.height;
   const int grow_x = w / 2, grow_y = h / 2;
   const Box grown = ClipToImage(Box{r.x - grow_x, r.y - grow_y, w + 2 * grow_x, h + 2 * grow_y},
                                 region_size_.width, region_size_.height);
+  const cv::Point to_colour = region_in_colour_.tl();
+  cv::Rect box_in_colour(r.tl() + to_colour, r.size());
   cv::Rect grown_in_colour(grown.rect().tl() + to_colour, grown.rect().size());
   // The documented approximation for large boxes (header): snap both to the cell grid. Sides of
   // at least two cells keep the snapped box non-empty; snapping is monotone, so the snapped grown
@@ -261,7 +285,6 @@ BoxFeatureVector BoxFeatureExtractor::Compute(const Box& box, float objectness) 
   f[18] = CosineDistance(box_hist.data() + kHueBins, ring_hist.data() + kHueBins, kSatValBins);
   f[19] = CosineDistance(box_hist.data() + kHueBins + kSatValBins,
                          ring_hist.data() + kHueBins + kSatValBins, kSatValBins);
-  return f;
 }
 
 cv::Mat1f BoxFeatureExtractor::ComputeAll(const std::vector<ScoredBox>& proposals) const {

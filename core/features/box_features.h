@@ -131,6 +131,12 @@ class BoxFeatureExtractor {
  private:
   // Validates, then builds the sparse edge map; leaves the extractor empty on error.
   void Init(const cv::Mat1f& region_map);
+  // Compute's steps for the box `r`, clipped to the region, in region-local coordinates.
+  void AddEdgeFeatures(const cv::Rect& r, BoxFeatureVector& f) const;      // 1-7
+  void AddPlaceFeatures(const cv::Rect& r, BoxFeatureVector& f) const;     // 8, 9, 11-14
+  void AddColourSpread(const cv::Rect& r, BoxFeatureVector& f) const;      // 15-17
+  void AddEdgeOrientation(const cv::Rect& r, BoxFeatureVector& f) const;   // 21 (and 22)
+  void AddSurroundContrast(const cv::Rect& r, BoxFeatureVector& f) const;  // 18-20
 
   Status status_;
   BoxFeatureOptions options_;
