@@ -230,8 +230,10 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
   return j;
 }
 
-std::string FormatEvalTables(const EvalReport& r) {
-  std::ostringstream o;
+namespace {
+
+// What was evaluated, how the maps and regressors were set, and the reported obstacles.
+void FormatEvalSummary(const EvalReport& r, std::ostringstream& o) {
   o << "frames " << r.frames << ", obstacle instances " << r.instances << "\n";
   o << "free space (FPR, AP negatives): " << r.free_space << "\n";
   o << "paper's map: "
@@ -243,37 +245,36 @@ std::string FormatEvalTables(const EvalReport& r) {
     << "\n";
   o << "regressors: " << r.proposal_features << " proposal features (" << r.proposal_feature_set
     << ")\n";
-  {
-    const ReportedObstacleCounts& a = r.reported;
-    char text[256];
-    std::snprintf(text, sizeof text,
-                  "reported obstacles (score >= %.2f): %.2f false alarms per frame, %.2f per "
-                  "obstacle-free frame (%d such frames), %.2f of instances found\n",
-                  DetectOptions{}.min_obstacle_score,
-                  r.frames ? static_cast<double>(a.false_alarms) / r.frames : 0.0,
-                  a.obstacle_free_frames ? static_cast<double>(a.false_alarms_on_obstacle_free) /
-                                               a.obstacle_free_frames
-                                         : 0.0,
-                  a.obstacle_free_frames,
-                  r.instances ? static_cast<double>(a.instances_found) / r.instances : 0.0);
-    o << text;
-  }
+  const ReportedObstacleCounts& a = r.reported;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "reported obstacles (score >= %.2f): %.2f false alarms per frame, %.2f per "
+                "obstacle-free frame (%d such frames), %.2f of instances found\n",
+                DetectOptions{}.min_obstacle_score,
+                r.frames ? static_cast<double>(a.false_alarms) / r.frames : 0.0,
+                a.obstacle_free_frames
+                    ? static_cast<double>(a.false_alarms_on_obstacle_free) / a.obstacle_free_frames
+                    : 0.0,
+                a.obstacle_free_frames,
+                r.instances ? static_cast<double>(a.instances_found) / r.instances : 0.0);
+  o << text;
   for (const SkippedFrame& f : r.skipped)
     o << "skipped frame " << f.frame << ": " << f.reason << "\n";
-  o << "\n";
-  o << "Average recall (proposals)\n";
+}
+
+// One row of an average-recall table: the variant, then AR at each of kTableN.
+void FormatRecallRow(const std::string& name, const VariantCurves& c, std::ostringstream& o) {
   char line[256];
-  std::snprintf(line, sizeof line, "%-16s %7s %7s %7s %7s %7s\n", "variant", "200", "400", "600",
-                "800", "1000");
+  std::snprintf(line, sizeof line, "%-16s", name.c_str());
   o << line;
-  auto ar_row = [&](const std::string& name, const VariantCurves& c) {
-    std::snprintf(line, sizeof line, "%-16s", name.c_str());
-    o << line;
-    for (int n : kTableN)
-      o << " " << std::string(7 - Fixed(c.ar_table.at(n)).size(), ' ') << Fixed(c.ar_table.at(n));
-    o << "\n";
-  };
-  for (const auto& v : ProposalVariants()) ar_row(v, r.proposals.at(v));
+  for (int n : kTableN)
+    o << " " << std::string(7 - Fixed(c.ar_table.at(n)).size(), ' ') << Fixed(c.ar_table.at(n));
+  o << "\n";
+}
+
+// TPR at the table's FPRs, then AP and FPR at 95 % TPR, per pixel map variant.
+void FormatPixelTables(const EvalReport& r, std::ostringstream& o) {
+  char line[256];
   o << "\nPixel ROC: TPR at FPR (regression)\n";
   std::snprintf(line, sizeof line, "%-16s", "variant");
   o << line;
@@ -298,8 +299,22 @@ std::string FormatEvalTables(const EvalReport& r) {
   if (r.roc.count(kCalibratedMapVariant))
     o << "(" << kCalibratedMapVariant
       << ": the calibrated map of BP+Fusion@4's boxes, not divided by the frame's maximum)\n";
+}
+
+}  // namespace
+
+std::string FormatEvalTables(const EvalReport& r) {
+  std::ostringstream o;
+  FormatEvalSummary(r, o);
+  o << "\nAverage recall (proposals)\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%-16s %7s %7s %7s %7s %7s\n", "variant", "200", "400", "600",
+                "800", "1000");
+  o << line;
+  for (const auto& v : ProposalVariants()) FormatRecallRow(v, r.proposals.at(v), o);
+  FormatPixelTables(r, o);
   o << "\nAverage recall (regressed, score > 0.25)\n";
-  for (const auto& v : RegressionVariants()) ar_row(v, r.regression.at(v));
+  for (const auto& v : RegressionVariants()) FormatRecallRow(v, r.regression.at(v), o);
   o << "\nMedian time per frame (ms)\n";
   for (const auto& [stage, ms] : r.stage_median_ms) {
     std::snprintf(line, sizeof line, "%-16s %9.1f\n", stage.c_str(), ms);
