@@ -192,10 +192,10 @@ Result<ServerConfig> ResolveServerConfig(const std::map<std::string, std::string
   return config;
 }
 
-Status ValidateServerConfig(const ServerConfig& config) {
-  if (config.model_dir.empty()) {
-    return Status::InvalidArgument("model: no model bundle given (--model DIR or TOD_MODEL)");
-  }
+namespace {
+
+// Ports, workers, threads, the frame budget and the queue.
+Status ValidateServing(const ServerConfig& config) {
   auto port_ok = [](int port) { return port >= 0 && port <= 65535; };
   if (!port_ok(config.grpc_port)) return Status::InvalidArgument("grpc_port: not in 0..65535");
   if (!port_ok(config.http_port)) return Status::InvalidArgument("http_port: not in 0..65535");
@@ -212,6 +212,11 @@ Status ValidateServerConfig(const ServerConfig& config) {
     return Status::InvalidArgument("frame_budget_ms: must be in 0..600000 (0: no budget)");
   }
   if (config.queue < 0) return Status::InvalidArgument("queue: must be >= 0");
+  return Status::Ok();
+}
+
+// What one image may cost before it is decoded.
+Status ValidateImageLimits(const ServerConfig& config) {
   if (config.max_image_bytes < 64 || config.max_image_bytes > (1u << 30)) {
     return Status::InvalidArgument("max_image_bytes: must be in 64..1073741824");
   }
@@ -219,6 +224,11 @@ Status ValidateServerConfig(const ServerConfig& config) {
     return Status::InvalidArgument("max_image_pixels: must be in 1.." +
                                    std::to_string(kAbsoluteMaxPixels));
   }
+  return Status::Ok();
+}
+
+// What one HTTP connection may hold, and for how long; drain and retry advice.
+Status ValidateHttpLimits(const ServerConfig& config) {
   if (!(config.drain_timeout_s >= 0 && config.drain_timeout_s <= 86400)) {
     return Status::InvalidArgument("drain_timeout_s: must be in 0..86400 seconds");
   }
@@ -253,6 +263,11 @@ Status ValidateServerConfig(const ServerConfig& config) {
       return Status::InvalidArgument(std::string(name) + ": must be in 0.1..3600 seconds");
     }
   }
+  return Status::Ok();
+}
+
+// TLS files come in pairs; the log format and level are known ones.
+Status ValidateTlsAndLogging(const ServerConfig& config) {
   if (config.tls_cert.empty() != config.tls_key.empty()) {
     return Status::InvalidArgument("tls_cert and tls_key: give both or neither");
   }
@@ -266,6 +281,19 @@ Status ValidateServerConfig(const ServerConfig& config) {
   if (std::find(levels.begin(), levels.end(), config.log_level) == levels.end()) {
     return Status::InvalidArgument("log_level: '" + config.log_level + "' is not one of " +
                                    "trace, debug, info, warn, error");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ValidateServerConfig(const ServerConfig& config) {
+  if (config.model_dir.empty()) {
+    return Status::InvalidArgument("model: no model bundle given (--model DIR or TOD_MODEL)");
+  }
+  for (const auto step :
+       {ValidateServing, ValidateImageLimits, ValidateHttpLimits, ValidateTlsAndLogging}) {
+    if (Status st = step(config); !st.ok()) return st;
   }
   return Status::Ok();
 }
