@@ -153,10 +153,11 @@ void DrawRoadMarkings(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
   }
 }
 
-void DrawHardNegatives(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
-  const RoadGeometry& road = layout.road;
+namespace {
+
+// Repair patches: rectangles or blobs of fresher / older asphalt.
+void DrawRepairPatches(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
   const cv::Vec3f road_colour = layout.materials.road.base;
-  // Repair patches: rectangles or blobs of fresher / older asphalt.
   for (int i = rng.UniformInt(0, 3); i > 0; --i) {
     const cv::Point2d c = RandomRoadPoint(layout, rng, layout.near_m, 60.0, 0.5);
     const double a = rng.Uniform(0.4, 3.0), b = rng.Uniform(0.4, 4.0), yaw = rng.Uniform(-0.3, 0.3);
@@ -177,19 +178,19 @@ void DrawHardNegatives(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
     RoadPolygon(canvas, layout, xz, road_colour * tone, static_cast<float>(rng.Uniform(0.6, 0.95)),
                 0.08f);
   }
-  for (int i = rng.UniformInt(0, 2); i > 0; --i) {
-    DrawManhole(canvas, layout, rng, RandomRoadPoint(layout, rng, layout.near_m, 50.0, 1.0));
-  }
-  if (rng.Chance(0.4))
-    DrawDrain(canvas, layout, rng, rng.Uniform(layout.near_m, 30.0), rng.Chance(0.5));
-  for (int i = rng.UniformInt(0, 4); i > 0; --i) {  // cracks and sealed joints: dark, thin
+}
+
+// Cracks and sealed joints (dark, thin), then chalk scrawls and spray-paint marks.
+void DrawRoadStrokes(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
+  const cv::Vec3f road_colour = layout.materials.road.base;
+  for (int i = rng.UniformInt(0, 4); i > 0; --i) {
     const cv::Point2d start = RandomRoadPoint(layout, rng, layout.near_m, 40.0, 0.3);
     RoadStroke(canvas, layout,
                RandomWalk(start, rng.UniformInt(4, 14), rng.Uniform(0.1, 0.4), 0.5, rng),
                rng.Uniform(0.01, 0.05), road_colour * 0.45f,
                static_cast<float>(rng.Uniform(0.4, 0.9)), 0.3f);
   }
-  for (int i = rng.UniformInt(0, 2); i > 0; --i) {  // chalk scrawls and spray-paint marks
+  for (int i = rng.UniformInt(0, 2); i > 0; --i) {
     const cv::Point2d start = RandomRoadPoint(layout, rng, layout.near_m, 30.0, 0.5);
     static const std::vector<cv::Vec3f> kChalk = {
         {235, 235, 235}, {120, 200, 240}, {200, 140, 230}, {90, 90, 230}, {230, 180, 90}};
@@ -198,7 +199,11 @@ void DrawHardNegatives(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
                rng.Uniform(0.02, 0.07), rng.Pick(kChalk),
                static_cast<float>(rng.Uniform(0.4, 0.85)), 0.4f);
   }
-  for (int i = rng.UniformInt(0, 3); i > 0; --i) {  // oil and water stains: soft, dark
+}
+
+// Oil and water stains: soft, dark.
+void DrawStains(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
+  for (int i = rng.UniformInt(0, 3); i > 0; --i) {
     const cv::Point2d c = RandomRoadPoint(layout, rng, layout.near_m, 50.0, 0.5);
     const Region stain =
         RasterisePolygons({GroundEllipse(layout.camera, c.x, c.y, rng.Uniform(0.2, 1.2),
@@ -207,50 +212,79 @@ void DrawHardNegatives(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
     Darken(canvas, stain, static_cast<float>(rng.Uniform(0.1, 0.35)),
            std::max(0.5, 0.3 * std::sqrt(static_cast<double>(stain.roi.area()))));
   }
-  // Shadows of things outside the road: tree canopies (soft blobs), poles, building edges.
-  const float strength = layout.light.shadow_strength;
+}
+
+// A tree canopy's shadow at ground point (x, z): a few overlapping soft ellipses.
+void DrawCanopyShadow(Canvas& canvas, const SceneLayout& layout, Rng& rng, double x, double z) {
+  std::vector<std::vector<cv::Point2d>> blobs;
+  for (int k = rng.UniformInt(2, 5); k > 0; --k) {
+    blobs.push_back(GroundEllipse(layout.camera, x + rng.Uniform(-1.5, 1.5),
+                                  z + rng.Uniform(-1.5, 1.5), rng.Uniform(0.8, 2.5),
+                                  rng.Uniform(0.8, 2.5), rng.Uniform(0, CV_PI)));
+  }
+  const Region r = RasterisePolygons(blobs, canvas.size());
+  Darken(canvas, r, layout.light.shadow_strength, std::max(0.7, 0.02 * r.roi.width));
+}
+
+// A pole's or sign post's shadow from (x, z): a long thin strip across the road.
+void DrawPoleShadow(Canvas& canvas, const SceneLayout& layout, Rng& rng, double x, double z) {
+  const double yaw = rng.Uniform(-1.2, 1.2), len = rng.Uniform(4, 12);
+  const std::vector<cv::Point2d> line = {{x, z},
+                                         {x + len * std::sin(yaw), z + len * std::cos(yaw)}};
+  Darken(
+      canvas,
+      RasterisePolygons(GroundStroke(layout.camera, line, rng.Uniform(0.1, 0.25)), canvas.size()),
+      layout.light.shadow_strength, 0.7);
+}
+
+// A building's or wall's shadow at distance z: a large polygon reaching in from one side.
+void DrawWallShadow(Canvas& canvas, const SceneLayout& layout, Rng& rng, double z) {
+  const RoadGeometry& road = layout.road;
+  const double side = rng.Chance(0.5) ? -1.0 : 1.0;
+  const double far_edge = side < 0 ? road.LeftEdgeAt(z) - 10 : road.RightEdgeAt(z) + 10;
+  const double reach = rng.Uniform(0.1, 0.6) * road.width_m;
+  const double near_edge = (side < 0 ? road.LeftEdgeAt(z) : road.RightEdgeAt(z)) - side * reach;
+  const double len = rng.Uniform(3, 20);
+  Darken(canvas,
+         RasterisePolygons({ProjectGroundPolygon(layout.camera, {{far_edge, z},
+                                                                 {near_edge, z + len * 0.2},
+                                                                 {near_edge, z + len},
+                                                                 {far_edge, z + len}})},
+                           canvas.size()),
+         layout.light.shadow_strength, 1.0);
+}
+
+// Shadows of things outside the road: tree canopies, poles, building edges.
+void DrawOutsideShadows(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
+  const RoadGeometry& road = layout.road;
   for (int i = rng.UniformInt(0, layout.light.sunny ? 4 : 1); i > 0; --i) {
     const double z = rng.LogUniform(layout.near_m, std::min(road.end_m, 60.0));
     const double x = road.CentreAt(z) + rng.Uniform(-0.7, 0.7) * road.width_m;
     switch (rng.UniformInt(0, 2)) {
-      case 0: {  // canopy: a few overlapping ellipses
-        std::vector<std::vector<cv::Point2d>> blobs;
-        for (int k = rng.UniformInt(2, 5); k > 0; --k) {
-          blobs.push_back(GroundEllipse(layout.camera, x + rng.Uniform(-1.5, 1.5),
-                                        z + rng.Uniform(-1.5, 1.5), rng.Uniform(0.8, 2.5),
-                                        rng.Uniform(0.8, 2.5), rng.Uniform(0, CV_PI)));
-        }
-        const Region r = RasterisePolygons(blobs, canvas.size());
-        Darken(canvas, r, strength, std::max(0.7, 0.02 * r.roi.width));
+      case 0:
+        DrawCanopyShadow(canvas, layout, rng, x, z);
         break;
-      }
-      case 1: {  // pole or sign post: a long thin strip across the road
-        const double yaw = rng.Uniform(-1.2, 1.2), len = rng.Uniform(4, 12);
-        const std::vector<cv::Point2d> line = {{x, z},
-                                               {x + len * std::sin(yaw), z + len * std::cos(yaw)}};
-        Darken(canvas,
-               RasterisePolygons(GroundStroke(layout.camera, line, rng.Uniform(0.1, 0.25)),
-                                 canvas.size()),
-               strength, 0.7);
+      case 1:
+        DrawPoleShadow(canvas, layout, rng, x, z);
         break;
-      }
-      default: {  // building or wall edge: a large polygon from one side
-        const double side = rng.Chance(0.5) ? -1.0 : 1.0;
-        const double far_edge = side < 0 ? road.LeftEdgeAt(z) - 10 : road.RightEdgeAt(z) + 10;
-        const double reach = rng.Uniform(0.1, 0.6) * road.width_m;
-        const double near_edge =
-            (side < 0 ? road.LeftEdgeAt(z) : road.RightEdgeAt(z)) - side * reach;
-        const double len = rng.Uniform(3, 20);
-        Darken(canvas,
-               RasterisePolygons({ProjectGroundPolygon(layout.camera, {{far_edge, z},
-                                                                       {near_edge, z + len * 0.2},
-                                                                       {near_edge, z + len},
-                                                                       {far_edge, z + len}})},
-                                 canvas.size()),
-               strength, 1.0);
-      }
+      default:
+        DrawWallShadow(canvas, layout, rng, z);
     }
   }
+}
+
+}  // namespace
+
+void DrawHardNegatives(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
+  DrawRepairPatches(canvas, layout, rng);
+  for (int i = rng.UniformInt(0, 2); i > 0; --i) {
+    DrawManhole(canvas, layout, rng, RandomRoadPoint(layout, rng, layout.near_m, 50.0, 1.0));
+  }
+  if (rng.Chance(0.4))
+    DrawDrain(canvas, layout, rng, rng.Uniform(layout.near_m, 30.0), rng.Chance(0.5));
+  DrawRoadStrokes(canvas, layout, rng);
+  DrawStains(canvas, layout, rng);
+  DrawOutsideShadows(canvas, layout, rng);
 }
 
 }  // namespace tod::synth
