@@ -127,12 +127,9 @@ std::uint64_t Modd2SynthFrameSeed(std::uint64_t dataset_seed, int sequence_index
              static_cast<std::uint64_t>(frame_index));
 }
 
-Modd2SynthFrame GenerateModd2SynthFrame(int width, int height, std::uint64_t seed) {
-  width = std::max(width, kModd2SynthMinWidth);
-  height = std::max(height, kModd2SynthMinHeight);
-  Rng rng(seed);
-  Modd2SynthFrame frame;
+namespace {
 
+Horizon RandomHorizon(int width, int height, Rng& rng) {
   Horizon horizon;
   horizon.width = width;
   horizon.base = rng.Uniform(0.33, 0.45) * height;
@@ -140,28 +137,33 @@ Modd2SynthFrame GenerateModd2SynthFrame(int width, int height, std::uint64_t see
   horizon.amplitude = rng.Uniform(0.3, 1.5);
   horizon.period = rng.Uniform(0.3, 0.8) * width;
   horizon.phase = rng.Uniform(0, 2 * std::numbers::pi);
+  return horizon;
+}
 
-  // Sea edge, left to right, 1-based. Like the real annotations, the end points may lie a little
-  // outside the image and a NaN row may appear; the reader cleans both.
+// Sea edge, left to right, 1-based, into the annotation. Like the real annotations, the end
+// points may lie a little outside the image and a NaN row may appear; the reader cleans both.
+// Returns the largest 1-based y of the edge.
+double AnnotateSeaEdge(const Horizon& horizon, int width, Rng& rng, Modd2Annotation& annotation) {
   const int points = 16;
-  double lowest_edge = 0;  // largest 1-based y of the edge
+  double lowest_edge = 0;
   for (int k = 0; k < points; ++k) {
     double x = 1 + (width - 1) * static_cast<double>(k) / (points - 1);
     if (k == 0 && rng.Chance(0.5)) x -= rng.Uniform(0.1, 1.5);
     if (k == points - 1 && rng.Chance(0.5)) x += rng.Uniform(0.1, 1.5);
     const double y = horizon.At(std::clamp(x, 1.0, static_cast<double>(width)));
-    frame.annotation.sea_edge.emplace_back(x, y);
+    annotation.sea_edge.emplace_back(x, y);
     lowest_edge = std::max(lowest_edge, y);
     if (k == points / 2 && rng.Chance(0.3)) {
-      frame.annotation.sea_edge.emplace_back(std::nan(""), std::nan(""));
+      annotation.sea_edge.emplace_back(std::nan(""), std::nan(""));
     }
   }
-  const std::vector<cv::Point2d> cleaned = CleanSeaEdge(frame.annotation.sea_edge, width, height);
-  const cv::Mat1b water = Modd2WaterMask(cleaned, width, height);
-  frame.image = cv::Mat3b(height, width);
-  PaintSkyAndWater(water, horizon, rng, &frame.image);
+  return lowest_edge;
+}
 
-  // Large obstacles straddle the horizon: their top is well above the sea edge.
+// Large obstacles straddle the horizon: their top is well above the sea edge. None, one or two,
+// apart from each other.
+std::vector<Box> PlaceLargeObstacles(const Horizon& horizon, int width, int height, Rng& rng) {
+  std::vector<Box> placed;
   const int large_count = rng.Chance(0.3) ? 0 : (rng.Chance(0.7) ? 1 : 2);
   for (int i = 0; i < large_count; ++i) {
     for (int attempt = 0; attempt < 20; ++attempt) {
@@ -178,19 +180,24 @@ Modd2SynthFrame GenerateModd2SynthFrame(int width, int height, std::uint64_t see
       const int bottom =
           std::min(height, static_cast<int>(std::ceil(edge_bottom)) + rng.Int(2, 2 + height / 25));
       const Box box{x, top, w, bottom - top};
-      if (OverlapsAny(box, frame.large_obstacles, 3)) continue;
-      frame.large_obstacles.push_back(box);
+      if (OverlapsAny(box, placed, 3)) continue;
+      placed.push_back(box);
       break;
     }
   }
-  for (const Box& b : frame.large_obstacles) PaintLargeObstacle(b, rng, &frame.image);
+  return placed;
+}
 
-  // Small floating objects, entirely on the water; nearer (lower) ones may be larger.
+// Small floating objects, entirely on the water below `lowest_edge` (1-based) and apart from
+// `large`; nearer (lower) ones may be larger.
+std::vector<Box> PlaceSmallObstacles(double lowest_edge, const std::vector<Box>& large, int width,
+                                     int height, Rng& rng) {
   const int first_row = static_cast<int>(std::ceil(lowest_edge)) + 3;  // 0-based, below the edge
   const int max_side_w = std::max(kMinObjectSide, std::min(width / 12, 40));
   const int max_side_h = std::max(kMinObjectSide, std::min(height / 10, 30));
   const int small_count = rng.Int(1, 4);
-  std::vector<Box> occupied = frame.large_obstacles;
+  std::vector<Box> occupied = large;
+  std::vector<Box> placed;
   for (int i = 0; i < small_count; ++i) {
     for (int attempt = 0; attempt < 30; ++attempt) {
       const int top = rng.Int(first_row, height - kMinObjectSide);
@@ -207,10 +214,31 @@ Modd2SynthFrame GenerateModd2SynthFrame(int width, int height, std::uint64_t see
       const Box box{x, top, w, h};
       if (h < kMinObjectSide || OverlapsAny(box, occupied, 2)) continue;
       occupied.push_back(box);
-      frame.small_obstacles.push_back(box);
+      placed.push_back(box);
       break;
     }
   }
+  return placed;
+}
+
+}  // namespace
+
+Modd2SynthFrame GenerateModd2SynthFrame(int width, int height, std::uint64_t seed) {
+  width = std::max(width, kModd2SynthMinWidth);
+  height = std::max(height, kModd2SynthMinHeight);
+  Rng rng(seed);
+  Modd2SynthFrame frame;
+  const Horizon horizon = RandomHorizon(width, height, rng);
+  const double lowest_edge = AnnotateSeaEdge(horizon, width, rng, frame.annotation);
+  const std::vector<cv::Point2d> cleaned = CleanSeaEdge(frame.annotation.sea_edge, width, height);
+  const cv::Mat1b water = Modd2WaterMask(cleaned, width, height);
+  frame.image = cv::Mat3b(height, width);
+  PaintSkyAndWater(water, horizon, rng, &frame.image);
+
+  frame.large_obstacles = PlaceLargeObstacles(horizon, width, height, rng);
+  for (const Box& b : frame.large_obstacles) PaintLargeObstacle(b, rng, &frame.image);
+  frame.small_obstacles =
+      PlaceSmallObstacles(lowest_edge, frame.large_obstacles, width, height, rng);
   for (const Box& b : frame.small_obstacles) PaintFloatingObject(b, rng, &frame.image);
 
   // Annotation rows: small objects first (their order is small_obstacles' order), then large.
