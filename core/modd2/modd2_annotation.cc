@@ -172,24 +172,62 @@ std::string Shape(const NumericMatrix& m) {
 
 }  // namespace
 
-Result<Modd2Annotation> ReadModd2Annotation(const std::string& mat_path) {
+namespace {
+
+// libmatio allocates whatever sizes the file claims: the file's size and its declared sizes are
+// checked before it sees the file (mat5_bounds.h).
+Status CheckBeforeMatio(const std::string& mat_path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(mat_path, ec)) {
     return Status::NotFound(mat_path + ": annotation file not found");
   }
-  // libmatio allocates whatever sizes the file claims: check them first (mat5_bounds.h).
-  {
-    const auto bytes = std::filesystem::file_size(mat_path, ec);
-    if (ec) return Status::NotFound(mat_path + ": cannot read the annotation file");
-    if (bytes > kMaxMatFileBytes) {
-      return Status::DataLoss(mat_path + ": " + std::to_string(bytes) +
-                              " bytes is too large for an annotation file");
-    }
-    std::ifstream in(mat_path, std::ios::binary);
-    const std::string contents((std::istreambuf_iterator<char>(in)),
-                               std::istreambuf_iterator<char>());
-    if (Status bounds = CheckMat5Bounds(contents, mat_path); !bounds.ok()) return bounds;
+  const auto bytes = std::filesystem::file_size(mat_path, ec);
+  if (ec) return Status::NotFound(mat_path + ": cannot read the annotation file");
+  if (bytes > kMaxMatFileBytes) {
+    return Status::DataLoss(mat_path + ": " + std::to_string(bytes) +
+                            " bytes is too large for an annotation file");
   }
+  std::ifstream in(mat_path, std::ios::binary);
+  const std::string contents((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+  return CheckMat5Bounds(contents, mat_path);
+}
+
+// Nx2 [x y] points. Empty arrays of any shape (0x0, 0x2) mean "no points".
+Result<std::vector<cv::Point2d>> SeaEdgePoints(const NumericMatrix& m, const std::string& where) {
+  std::vector<cv::Point2d> points;
+  if (m.values.empty()) return points;
+  if (m.cols != 2) {
+    return Status::InvalidArgument(where + " is " + Shape(m) + ", expected Nx2 [x y] points");
+  }
+  for (std::size_t r = 0; r < m.rows; ++r) points.emplace_back(m.at(r, 0), m.at(r, 1));
+  return points;
+}
+
+// Mx4 [x y w h] boxes. Empty arrays of any shape (0x0, 0x4) mean "no obstacles". The sea edge
+// may hold NaN / Inf by design; a box may not (the official code would index with it and fail).
+Result<std::vector<cv::Rect2d>> ObstacleBoxes(const NumericMatrix& m, const std::string& where) {
+  std::vector<cv::Rect2d> boxes;
+  if (m.values.empty()) return boxes;
+  if (m.cols != 4) {
+    return Status::InvalidArgument(where + " is " + Shape(m) + ", expected Mx4 [x y w h] boxes");
+  }
+  for (std::size_t r = 0; r < m.rows; ++r) {
+    const cv::Rect2d box(m.at(r, 0), m.at(r, 1), m.at(r, 2), m.at(r, 3));
+    if (!std::isfinite(box.x) || !std::isfinite(box.y) || !std::isfinite(box.width) ||
+        !std::isfinite(box.height)) {
+      return Status::InvalidArgument(where + " row " + std::to_string(r + 1) +
+                                     " holds a non-finite value");
+    }
+    boxes.push_back(box);
+  }
+  return boxes;
+}
+
+}  // namespace
+
+Result<Modd2Annotation> ReadModd2Annotation(const std::string& mat_path) {
+  if (Status checked = CheckBeforeMatio(mat_path); !checked.ok()) return checked;
   const MatFile mat(Mat_Open(mat_path.c_str(), MAT_ACC_RDONLY));
   if (!mat) return Status::DataLoss(mat_path + ": not a readable MAT file");
   const MatVar annotations(Mat_VarRead(mat.get(), "annotations"));
@@ -207,41 +245,18 @@ Result<Modd2Annotation> ReadModd2Annotation(const std::string& mat_path) {
   if (sea_edge_var == nullptr) return Status::NotFound(prefix + "sea_edge' missing");
   const matvar_t* obstacles_var = FindField(annotations.get(), "obstacles");
   if (obstacles_var == nullptr) return Status::NotFound(prefix + "obstacles' missing");
-
   Result<NumericMatrix> sea_edge = ReadNumericMatrix(sea_edge_var, prefix + "sea_edge'");
   if (!sea_edge.ok()) return sea_edge.status();
   Result<NumericMatrix> obstacles = ReadNumericMatrix(obstacles_var, prefix + "obstacles'");
   if (!obstacles.ok()) return obstacles.status();
 
   Modd2Annotation annotation;
-  // Empty arrays of any shape (0x0, 0x2, 0x4) mean "no points" / "no obstacles".
-  if (!sea_edge->values.empty()) {
-    if (sea_edge->cols != 2) {
-      return Status::InvalidArgument(prefix + "sea_edge' is " + Shape(*sea_edge) +
-                                     ", expected Nx2 [x y] points");
-    }
-    for (std::size_t r = 0; r < sea_edge->rows; ++r) {
-      annotation.sea_edge.emplace_back(sea_edge->at(r, 0), sea_edge->at(r, 1));
-    }
-  }
-  if (!obstacles->values.empty()) {
-    if (obstacles->cols != 4) {
-      return Status::InvalidArgument(prefix + "obstacles' is " + Shape(*obstacles) +
-                                     ", expected Mx4 [x y w h] boxes");
-    }
-    for (std::size_t r = 0; r < obstacles->rows; ++r) {
-      const cv::Rect2d box(obstacles->at(r, 0), obstacles->at(r, 1), obstacles->at(r, 2),
-                           obstacles->at(r, 3));
-      // The sea edge may hold NaN / Inf by design; a box may not (the official code would index
-      // with it and fail).
-      if (!std::isfinite(box.x) || !std::isfinite(box.y) || !std::isfinite(box.width) ||
-          !std::isfinite(box.height)) {
-        return Status::InvalidArgument(prefix + "obstacles' row " + std::to_string(r + 1) +
-                                       " holds a non-finite value");
-      }
-      annotation.obstacles.push_back(box);
-    }
-  }
+  auto points = SeaEdgePoints(*sea_edge, prefix + "sea_edge'");
+  if (!points.ok()) return points.status();
+  annotation.sea_edge = std::move(*points);
+  auto boxes = ObstacleBoxes(*obstacles, prefix + "obstacles'");
+  if (!boxes.ok()) return boxes.status();
+  annotation.obstacles = std::move(*boxes);
   return annotation;
 }
 
