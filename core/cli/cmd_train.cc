@@ -158,6 +158,10 @@ void AddProposalAndMapOptions(CLI::App* cmd, TrainArgs& args) {
   cmd->add_option("--refine-limit", args.train.params.boxes.refine_limit,
                   "refine at most the N best grid local maxima per region (0 = all of them)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--wide-aspect-ratio", args.train.params.boxes.max_wide_aspect_ratio,
+                  "the proposal grid's widest window, w / h (ours, default 10: obstacles lying "
+                  "on the road are foreshortened; 0 = tau_a, the paper's grid, 4.2 : 1 at most)")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_flag("--refine-all", args.refine_all,
                 "refine every scoring window, as the paper (default: the 5000 best grid local "
                 "maxima per region)");

@@ -19,9 +19,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StickySuperpixelParams, k, alpha
                                                 strip_rows)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeBoxParams, alpha, beta, min_score, max_boxes,
                                                 edge_min_mag, edge_merge_thr, cluster_min_mag,
-                                                max_aspect_ratio, min_box_area, gamma, kappa,
-                                                min_stride, refine, refine_limit,
-                                                refine_local_maxima)
+                                                max_aspect_ratio, max_wide_aspect_ratio,
+                                                min_box_area, gamma, kappa, min_stride, refine,
+                                                refine_limit, refine_local_maxima)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FusionParams, beta1, keep_ratio)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BoxIsolationParams, exponent, context_boxes,
                                                 surround)
@@ -103,6 +103,7 @@ PipelineParams TrainingDefaultParams() {
   params.occlusion_screening = {.trees = 25, .final_at_most = 0.05f};
   params.probability_map.superpixel_shares = true;
   params.vertical_edge_feature = true;
+  params.boxes.max_wide_aspect_ratio = 10.f;
   return params;
 }
 

@@ -9,6 +9,7 @@
 #include "core/pipeline/training_geometry.h"
 #include "core/pipeline/training_regressors.h"
 #include "core/pipeline/training_run.h"
+#include "core/proposals/edge_box_scorer.h"
 
 namespace tod {
 namespace {
@@ -109,6 +110,9 @@ Result<ModelBundle> TrainModel(const TrainOptions& options) {
         "--negative-bags " + std::to_string(options.selection.negative_bags) +
         " is more than the regressors' " + std::to_string(options.regressor.num_trees) +
         " trees: every bag needs a tree of its own");
+  // A grid the proposal stage would refuse gives no boxes: say so before any frame is read.
+  if (Status st = ValidateEdgeBoxParams(options.params.boxes); !st.ok())
+    return Status::InvalidArgument("proposal parameters: " + st.message());
   TrainingRun run(options);
   if (Status st = run.Open(); !st.ok()) return st;
   ModelBundle bundle;

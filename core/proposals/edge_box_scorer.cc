@@ -37,6 +37,10 @@ Status ValidateEdgeBoxParams(const EdgeBoxParams& p) {
   if (!(p.max_aspect_ratio >= 1.f && p.max_aspect_ratio <= 1000.f)) {
     return OutOfRange("max_aspect_ratio", "in [1, 1000]", p.max_aspect_ratio);
   }
+  if (!(p.max_wide_aspect_ratio == 0.f ||
+        (p.max_wide_aspect_ratio >= 1.f && p.max_wide_aspect_ratio <= 1000.f))) {
+    return OutOfRange("max_wide_aspect_ratio", "0 or in [1, 1000]", p.max_wide_aspect_ratio);
+  }
   if (!(p.min_box_area >= 1.f)) return OutOfRange("min_box_area", ">= 1", p.min_box_area);
   if (!(p.gamma >= 0.f && std::isfinite(p.gamma))) return OutOfRange("gamma", ">= 0", p.gamma);
   if (!(p.kappa > 0.f && std::isfinite(p.kappa))) return OutOfRange("kappa", "> 0", p.kappa);

@@ -29,6 +29,9 @@ struct EdgeBoxParams {
   float kappa = 1.5f;            // size normalisation exponent
   float stride_factor = 1.f;     // MS: (K - k + 1) / K for region k; 1 = plain sliding window
   int min_stride = 2;            // px
+  // The wide side's bound on w / h (ours; 0 = tau_a, the paper's grid, symmetric about square).
+  // Obstacles lying on the road are seen at a grazing angle, foreshortened in height.
+  float max_wide_aspect_ratio = 0.f;
   bool refine = true;
   // Edge Boxes and the paper refine every window with a non-zero score (the defaults here).
   // Two APPROXIMATIONS narrow that down; windows left out keep their grid box and score:

@@ -21,15 +21,20 @@ std::vector<WindowShape> WindowShapes(int map_width, int map_height, const EdgeB
   const float scale_step = std::sqrt(1.f / params.alpha);
   const float aspect_step = (1.f + params.alpha) / (2.f * params.alpha);
   const float min_side = std::sqrt(params.min_box_area);
-  const int aspect_radius =
-      static_cast<int>(std::log(params.max_aspect_ratio) / std::log(aspect_step * aspect_step));
+  const auto aspect_radius_for = [&](float bound) {
+    return static_cast<int>(std::log(bound) / std::log(aspect_step * aspect_step));
+  };
+  const int tall_radius = aspect_radius_for(params.max_aspect_ratio);
+  const int wide_radius = params.max_wide_aspect_ratio > 0.f
+                              ? aspect_radius_for(std::max(params.max_wide_aspect_ratio, 1.f))
+                              : tall_radius;
   const int scale_count = static_cast<int>(
       std::ceil(std::log(static_cast<float>(std::max(map_width, map_height)) / min_side) /
                 std::log(scale_step)));
   for (int s = 0; s < scale_count; ++s) {
     const float side = min_side * std::pow(scale_step, static_cast<float>(s));
-    for (int a = 0; a <= 2 * aspect_radius; ++a) {
-      const float aspect = std::pow(aspect_step, static_cast<float>(a - aspect_radius));
+    for (int a = -tall_radius; a <= wide_radius; ++a) {
+      const float aspect = std::pow(aspect_step, static_cast<float>(a));
       WindowShape shape;
       shape.height = static_cast<int>(side / aspect);
       shape.width = static_cast<int>(side * aspect);

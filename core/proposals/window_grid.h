@@ -22,7 +22,8 @@ struct WindowShape {
 // Delta = max(min_stride, floor((1 - alpha) / (1 + alpha) * stride_factor * side)) (§4.2.6).
 int WindowStride(int side, const EdgeBoxParams& params);
 
-// All shapes in generation order: scale-major, then aspect index a = 0 .. 2 arRad.
+// All shapes in generation order: scale-major, then aspect index a = -arRad(tau_a) ..
+// arRad(max_wide_aspect_ratio), tallest first (a = 0 is square).
 std::vector<WindowShape> WindowShapes(int map_width, int map_height, const EdgeBoxParams& params);
 
 // Positions x = 0, stride_x, ... while x < map_width - width + stride_x (rows likewise).

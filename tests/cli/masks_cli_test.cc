@@ -116,6 +116,7 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
   // The occlusion classifier's early exit, on in a new bundle: 25 trees, bound 0.05.
   EXPECT_EQ(manifest["params"]["occlusion_screening"]["trees"], 25);
   EXPECT_FLOAT_EQ(manifest["params"]["occlusion_screening"]["final_at_most"].get<float>(), 0.05f);
+  EXPECT_FLOAT_EQ(manifest["params"]["boxes"]["max_wide_aspect_ratio"].get<float>(), 10.f);
   const nlohmann::json& size_filter = manifest["training"]["parts"]["size_filter"];
   EXPECT_EQ(size_filter["recipe"], "ground_plane") << size_filter.dump();
   EXPECT_TRUE(size_filter["horizon_y"].is_number()) << size_filter.dump();
@@ -192,8 +193,9 @@ TEST_F(MasksCliTest, HardNegativeMiningByDefaultOneRoundOnRequest) {
   EXPECT_TRUE(m["training"]["seconds"].contains("hard_negatives"));
 }
 
-// The classifiers' tree counts, the occlusion classifier's early exit and the superpixels'
-// sweep order are choices the manifest records; out of range is refused before any work.
+// The classifiers' tree counts, the occlusion classifier's early exit, the proposal grid's wide
+// bound and the superpixels' sweep order are choices the manifest records; out of range is
+// refused before any work.
 TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   const std::string model = (out_ / "trees").string();
   const CommandResult run = RunCommand(
@@ -201,7 +203,7 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
             "--edge-trees 4 --occlusion-trees 12 --negatives-scale 2 --superpixel-strips 16 "
             "--edge-negatives 3 --occlusion-negatives 6 --occlusion-screen-trees 3 "
             "--occlusion-screen-below 0.25 --negative-bags 2 --regressor-mtry 4 "
-            "--regressor-min-leaf 7 --hard-fraction 0.5"));
+            "--regressor-min-leaf 7 --hard-fraction 0.5 --wide-aspect-ratio 3"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json manifest = Manifest(model);
   for (const char* regressor : {"ordr", "obdr"}) {
@@ -217,6 +219,7 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   EXPECT_EQ(bundle->ordr.num_trees(), 10);
   EXPECT_EQ(bundle->obdr.num_trees(), 10);
   EXPECT_EQ(manifest["params"]["superpixels"]["strip_rows"], 16);
+  EXPECT_FLOAT_EQ(manifest["params"]["boxes"]["max_wide_aspect_ratio"].get<float>(), 3.f);
   EXPECT_EQ(manifest["params"]["occlusion_screening"]["trees"], 3);
   EXPECT_FLOAT_EQ(manifest["params"]["occlusion_screening"]["final_at_most"].get<float>(), 0.25f);
   EXPECT_EQ(manifest["training"]["parts"]["edges"]["trees"], 4);
@@ -231,8 +234,8 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
   for (const char* flag :
        {"--edge-trees 0", "--negatives-scale 0", "--superpixel-strips -1", "--edge-negatives 0",
         "--occlusion-negatives 0", "--occlusion-screen-trees -1", "--occlusion-screen-below 1",
-        "--negative-bags 0", "--regressor-mtry 0", "--regressor-min-leaf 0",
-        "--hard-fraction 1.5"}) {
+        "--negative-bags 0", "--regressor-mtry 0", "--regressor-min-leaf 0", "--hard-fraction 1.5",
+        "--wide-aspect-ratio -1"}) {
     const CommandResult wrong = RunCommand(Train((out_ / "wrong").string(), flag));
     EXPECT_NE(wrong.exit_code, 0) << flag;
     EXPECT_NE(wrong.output.find(std::string(flag).substr(0, std::string(flag).find(' '))),
@@ -240,6 +243,12 @@ TEST_F(MasksCliTest, ForestSizesAndRegressorNegativesAreChoicesAndRecorded) {
         << wrong.output;
     EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
   }
+  // A wide bound under 1 would be a grid without its square windows: refused by name.
+  const CommandResult narrow =
+      RunCommand(Train((out_ / "wrong").string(), "--wide-aspect-ratio 0.5"));
+  EXPECT_NE(narrow.exit_code, 0);
+  EXPECT_NE(narrow.output.find("max_wide_aspect_ratio"), std::string::npos) << narrow.output;
+  EXPECT_FALSE(fs::exists(out_ / "wrong" / "manifest.json"));
   // Every bag is a forest of its own, so there cannot be more bags than trees (10 here).
   const CommandResult too_many = RunCommand(Train((out_ / "wrong").string(), "--negative-bags 11"));
   EXPECT_NE(too_many.exit_code, 0);

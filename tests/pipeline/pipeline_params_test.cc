@@ -11,6 +11,7 @@ TEST(PipelineParams, DefaultsAreThePapers) {
   EXPECT_FLOAT_EQ(p.boxes.alpha, 0.65f);
   EXPECT_FLOAT_EQ(p.boxes.beta, 0.75f);
   EXPECT_FLOAT_EQ(p.boxes.max_aspect_ratio, 6.f);
+  EXPECT_FLOAT_EQ(p.boxes.max_wide_aspect_ratio, 0.f);  // tau_a on both sides
   EXPECT_FLOAT_EQ(p.fusion.beta1, 0.3f);
   EXPECT_FLOAT_EQ(p.probability_map.nms_iou, 0.7f);
   EXPECT_TRUE(p.multistride);
@@ -30,6 +31,9 @@ TEST(PipelineParams, JsonRoundTripAndMissingKeysKeepDefaults) {
   EXPECT_FLOAT_EQ(partial->fusion.beta1, 0.5f);
   EXPECT_FLOAT_EQ(partial->fusion.keep_ratio, 0.5f);
   EXPECT_EQ(partial->superpixels.k, 1024);
+  // A manifest from before the wide bound keeps the paper's grid; `tod train` writes 10.
+  EXPECT_FLOAT_EQ(partial->boxes.max_wide_aspect_ratio, 0.f);
+  EXPECT_FLOAT_EQ(TrainingDefaultParams().boxes.max_wide_aspect_ratio, 10.f);
 }
 
 // The regressors' row width and its words follow the two optional features, each on its own;

@@ -186,6 +186,13 @@ TEST(ScoreEdgeBoxesTest, InvalidParametersAreReportedAndYieldNothing) {
   params = EdgeBoxParams{};
   params.min_stride = 0;
   EXPECT_FALSE(ValidateEdgeBoxParams(params).ok());
+  // The wide bound: 0 (tau_a, the paper's grid) or a ratio of at least 1.
+  params = EdgeBoxParams{};
+  params.max_wide_aspect_ratio = 10.f;
+  EXPECT_TRUE(ValidateEdgeBoxParams(params).ok());
+  params.max_wide_aspect_ratio = 0.5f;
+  EXPECT_NE(ValidateEdgeBoxParams(params).message().find("max_wide_aspect_ratio"),
+            std::string::npos);
 }
 
 TEST(NormaliseToMaxTest, DividesByMaxAndKeepsAllZeroMaps) {

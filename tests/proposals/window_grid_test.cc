@@ -43,6 +43,37 @@ TEST(WindowGridTest, AspectRatiosFollowTheStep) {
   EXPECT_EQ(WindowShapes(20, 20, params).size() % 5, 0u);
 }
 
+TEST(WindowGridTest, WideAspectBoundAddsOnlyWideShapes) {
+  // tau_a = 6 keeps the tall side at arRad 3 (w / h down to 0.239); a wide bound of 10 gives
+  // floor(ln 10 / ln(1.2692^2)) = 4 wide steps (w / h up to 1.2692^8 = 6.72): 8 aspects a scale.
+  EdgeBoxParams paper;
+  EdgeBoxParams wide = paper;
+  wide.max_wide_aspect_ratio = 10.f;
+  const auto paper_shapes = WindowShapes(40, 40, paper);
+  const auto wide_shapes = WindowShapes(40, 40, wide);
+  ASSERT_EQ(paper_shapes.size() % 7, 0u);
+  ASSERT_EQ(wide_shapes.size() % 8, 0u);
+  ASSERT_EQ(paper_shapes.size() / 7, wide_shapes.size() / 8);  // the same scales
+  for (std::size_t scale = 0; scale < paper_shapes.size() / 7; ++scale) {
+    // The paper's seven aspects first, in the same order, then the one wider step.
+    for (std::size_t a = 0; a < 7; ++a) {
+      EXPECT_EQ(wide_shapes[scale * 8 + a].width, paper_shapes[scale * 7 + a].width);
+      EXPECT_EQ(wide_shapes[scale * 8 + a].height, paper_shapes[scale * 7 + a].height);
+    }
+    const WindowShape& widest = wide_shapes[scale * 8 + 7];
+    const WindowShape& paper_widest = paper_shapes[scale * 7 + 6];
+    EXPECT_GT(widest.width, paper_widest.width);
+    EXPECT_LT(widest.height, paper_widest.height);
+  }
+  // Scale 0 (side 10): ar = 1.2692^4 = 2.595, w = floor(25.95) = 25, h = floor(3.85) = 3.
+  EXPECT_EQ(wide_shapes[7].width, 25);
+  EXPECT_EQ(wide_shapes[7].height, 3);
+  // 0 means tau_a: the paper's grid exactly.
+  wide.max_wide_aspect_ratio = 0.f;
+  EXPECT_EQ(WindowShapes(40, 40, wide).size(), paper_shapes.size());
+  EXPECT_EQ(CountWindows(40, 40, wide), CountWindows(40, 40, paper));
+}
+
 TEST(WindowGridTest, StrideFormulaAndFloor) {
   EdgeBoxParams params;  // (1 - 0.65) / (1 + 0.65) = 0.21212
   EXPECT_EQ(WindowStride(10, params), 2);
