@@ -6,6 +6,86 @@
 
 namespace tod {
 
+namespace {
+
+// A maximal horizontal stretch of one label in one row.
+struct Run {
+  int start;  // first column
+  int end;    // one past the last column
+  int label;
+};
+
+// The runs of a row-major label map in raster order; row_first[y] is the index of row y's first
+// run (row_first[height] = the number of runs).
+struct RunsOfRows {
+  std::vector<Run> runs;
+  std::vector<size_t> row_first;
+};
+
+RunsOfRows CollectRuns(const int* l, int width, int height) {
+  RunsOfRows out;
+  out.row_first.resize(static_cast<size_t>(height) + 1);
+  for (int y = 0; y < height; ++y) {
+    out.row_first[y] = out.runs.size();
+    const int* const row = l + static_cast<size_t>(y) * width;
+    for (int x = 0; x < width;) {
+      const int start = x;
+      const int label = row[x];
+      while (++x < width && row[x] == label) {
+      }
+      out.runs.push_back({start, x, label});
+    }
+  }
+  out.row_first[height] = out.runs.size();
+  return out;
+}
+
+// Union-find over runs; the root of a set is its earliest run.
+class RunSets {
+ public:
+  explicit RunSets(size_t count) : parent_(count) {
+    for (size_t r = 0; r < count; ++r) parent_[r] = r;
+  }
+  size_t Find(size_t r) {
+    while (parent_[r] != r) {
+      parent_[r] = parent_[parent_[r]];  // path halving
+      r = parent_[r];
+    }
+    return r;
+  }
+  void Unite(size_t a, size_t b) {
+    a = Find(a);
+    b = Find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+ private:
+  std::vector<size_t> parent_;
+};
+
+// A run 4-touches a run of the row above exactly when their column ranges overlap, so a merge
+// walk over each pair of rows unites every such pair with the same label.
+void UniteTouchingRuns(const RunsOfRows& rows, int height, RunSets& sets) {
+  const std::vector<Run>& runs = rows.runs;
+  for (int y = 1; y < height; ++y) {
+    size_t up = rows.row_first[y - 1];
+    size_t down = rows.row_first[y];
+    const size_t up_end = rows.row_first[y];
+    const size_t down_end = rows.row_first[y + 1];
+    // Invariant: runs `up` and `down` overlap (both rows start at column 0; the run that ends
+    // first is replaced by its successor, which starts where it ended, inside the other run).
+    while (up < up_end && down < down_end) {
+      if (runs[up].label == runs[down].label) sets.Unite(up, down);
+      const int up_stop = runs[up].end;
+      const int down_stop = runs[down].end;
+      if (up_stop <= down_stop) ++up;
+      if (down_stop <= up_stop) ++down;
+    }
+  }
+}
+
+}  // namespace
+
 int RelabelConnectedComponents(cv::Mat1i& labels) {
   const int width = labels.cols;
   const int height = labels.rows;
@@ -13,75 +93,28 @@ int RelabelConnectedComponents(cv::Mat1i& labels) {
   if (!labels.isContinuous()) labels = labels.clone();
   int* const l = labels.ptr<int>(0);
 
-  // Two passes over runs (maximal horizontal stretches of one label) instead of a per-pixel
-  // flood fill: a superpixel row is a few long runs, so the work is per run, with no stack, no
-  // division to recover coordinates and no unpredictable branch per pixel.
-  //  1. Runs, row by row in raster order; a run 4-touches a run of the row above exactly when
-  //     their column ranges overlap, so a merge walk over the two rows unites every such pair
-  //     with the same label (union-find; the root of a set is its earliest run).
+  // Two passes over runs instead of a per-pixel flood fill: a superpixel row is a few long runs,
+  // so the work is per run, with no stack, no division to recover coordinates and no
+  // unpredictable branch per pixel.
+  //  1. Runs, row by row in raster order, united with the touching runs of the row above.
   //  2. Ids in raster order of the runs: a component's first run holds its first pixel in raster
   //     order, so components are numbered in order of first appearance, which is exactly how the
   //     flood fill, seeding in raster order, numbered them.
-  struct Run {
-    int start;  // first column
-    int end;    // one past the last column
-    int label;
-  };
-  std::vector<Run> runs;
-  std::vector<size_t> row_first(static_cast<size_t>(height) + 1);
-  for (int y = 0; y < height; ++y) {
-    row_first[y] = runs.size();
-    const int* const row = l + static_cast<size_t>(y) * width;
-    for (int x = 0; x < width;) {
-      const int start = x;
-      const int label = row[x];
-      while (++x < width && row[x] == label) {
-      }
-      runs.push_back({start, x, label});
-    }
-  }
-  row_first[height] = runs.size();
+  const RunsOfRows rows = CollectRuns(l, width, height);
+  RunSets sets(rows.runs.size());
+  UniteTouchingRuns(rows, height, sets);
 
-  std::vector<size_t> parent(runs.size());
-  for (size_t r = 0; r < parent.size(); ++r) parent[r] = r;
-  const auto find = [&parent](size_t r) {
-    while (parent[r] != r) {
-      parent[r] = parent[parent[r]];  // path halving
-      r = parent[r];
-    }
-    return r;
-  };
-  for (int y = 1; y < height; ++y) {
-    size_t up = row_first[y - 1];
-    size_t down = row_first[y];
-    const size_t up_end = row_first[y];
-    const size_t down_end = row_first[y + 1];
-    // Invariant: runs `up` and `down` overlap (both rows start at column 0; the run that ends
-    // first is replaced by its successor, which starts where it ended, inside the other run).
-    while (up < up_end && down < down_end) {
-      if (runs[up].label == runs[down].label) {
-        const size_t a = find(up);
-        const size_t b = find(down);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-      }
-      const int up_stop = runs[up].end;
-      const int down_stop = runs[down].end;
-      if (up_stop <= down_stop) ++up;
-      if (down_stop <= up_stop) ++down;
-    }
-  }
-
-  std::vector<int> id(runs.size(), 0);
+  std::vector<int> id(rows.runs.size(), 0);
   int count = 0;
-  for (size_t r = 0; r < runs.size(); ++r) {
-    int& component = id[find(r)];
+  for (size_t r = 0; r < rows.runs.size(); ++r) {
+    int& component = id[sets.Find(r)];
     if (component == 0) component = ++count;
     id[r] = component;
   }
   for (int y = 0; y < height; ++y) {
     int* const row = l + static_cast<size_t>(y) * width;
-    for (size_t r = row_first[y]; r < row_first[y + 1]; ++r) {
-      std::fill(row + runs[r].start, row + runs[r].end, id[r]);
+    for (size_t r = rows.row_first[y]; r < rows.row_first[y + 1]; ++r) {
+      std::fill(row + rows.runs[r].start, row + rows.runs[r].end, id[r]);
     }
   }
   return count;
@@ -145,40 +178,12 @@ void SeparateDiagonalRow(const int* marks, int width, int height, int y, int* ou
   if (width > 1) pixel(width - 1, true, false);
 }
 
-}  // namespace
-
-void InsertSuperpixelBoundaries(const cv::Mat1f& edge, cv::Mat1i& labels) {
-  const int width = labels.cols;
-  const int height = labels.rows;
-  const size_t n = static_cast<size_t>(width) * height;
-  if (n == 0) return;
-  if (!labels.isContinuous()) labels = labels.clone();
-  int* const l = labels.ptr<int>(0);
-  const cv::Mat1f edge_c = edge.isContinuous() ? edge : edge.clone();
-  const float* const e = edge_c.ptr<float>(0);
-
-  // Steps 1 and 2 are written per pixel, as "is this pixel marked?" computed from its
-  // neighbourhood in the previous map, into a second map: no branch on the labels (whether two
-  // labels differ is unpredictable along the many short borders), no read-modify-write of marks.
-  // Missing neighbours (outside the image) take no part, as in the pairwise definitions. Each
-  // step is a pure function of a snapshot, row by row, so its rows run on OpenCV's pool.
-  std::vector<int> step1(n);
-  int* const marks = step1.data();
-  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y)
-      MarkStrongerEdgeRow(l, e, width, height, y, marks + static_cast<size_t>(y) * width);
-  });
-  // Step 2: separate diagonal contacts, judged on the step-1 map (a snapshot, so the raster order
-  // does not matter).
-  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y)
-      SeparateDiagonalRow(marks, width, height, y, l + static_cast<size_t>(y) * width);
-  });
-
-  // Step 3: thinning, in place so that two halves of a thick boundary cannot both be returned to
-  // their different sides. Whether the labelled 8-neighbours share one label does not depend on
-  // the order they are looked at, so pixels away from the image border take a path without
-  // bounds checks.
+// Step 3 of InsertSuperpixelBoundaries: a boundary pixel (0) whose labelled 8-neighbours all
+// share one label goes back to that label. In place, in raster order, so that two halves of a
+// thick boundary cannot both be returned to their different sides. Whether the labelled
+// 8-neighbours share one label does not depend on the order they are looked at, so pixels away
+// from the image border take a path without bounds checks.
+void ThinBoundaries(int* l, int width, int height) {
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const size_t i = static_cast<size_t>(y) * width + x;
@@ -215,6 +220,40 @@ void InsertSuperpixelBoundaries(const cv::Mat1f& edge, cv::Mat1i& labels) {
       if (single && shared != 0) l[i] = shared;
     }
   }
+}
+
+}  // namespace
+
+void InsertSuperpixelBoundaries(const cv::Mat1f& edge, cv::Mat1i& labels) {
+  const int width = labels.cols;
+  const int height = labels.rows;
+  const size_t n = static_cast<size_t>(width) * height;
+  if (n == 0) return;
+  if (!labels.isContinuous()) labels = labels.clone();
+  int* const l = labels.ptr<int>(0);
+  const cv::Mat1f edge_c = edge.isContinuous() ? edge : edge.clone();
+  const float* const e = edge_c.ptr<float>(0);
+
+  // Steps 1 and 2 are written per pixel, as "is this pixel marked?" computed from its
+  // neighbourhood in the previous map, into a second map: no branch on the labels (whether two
+  // labels differ is unpredictable along the many short borders), no read-modify-write of marks.
+  // Missing neighbours (outside the image) take no part, as in the pairwise definitions. Each
+  // step is a pure function of a snapshot, row by row, so its rows run on OpenCV's pool.
+  std::vector<int> step1(n);
+  int* const marks = step1.data();
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y)
+      MarkStrongerEdgeRow(l, e, width, height, y, marks + static_cast<size_t>(y) * width);
+  });
+  // Step 2: separate diagonal contacts, judged on the step-1 map (a snapshot, so the raster order
+  // does not matter).
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y)
+      SeparateDiagonalRow(marks, width, height, y, l + static_cast<size_t>(y) * width);
+  });
+
+  // Step 3: thinning.
+  ThinBoundaries(l, width, height);
 }
 
 int CompactLabels(cv::Mat1i& labels) {
