@@ -45,7 +45,19 @@ Result<ObstacleCalibration> FitObstacleCalibration(const std::vector<double>& ev
   }
   if (!std::isfinite(a) || !std::isfinite(b))
     return Status::Internal("obstacle calibration: the fit diverged");
-  return ObstacleCalibration{true, a, b, static_cast<int>(labels.size()), positives};
+  ObstacleCalibration fit{.fitted = true,
+                          .slope = a,
+                          .intercept = b,
+                          .samples = static_cast<int>(labels.size()),
+                          .positives = positives};
+  if (a < 0.0) {
+    const double mean_target =
+        (positives * hi + negatives * lo) / static_cast<double>(positives + negatives);
+    fit.slope = 0.0;
+    fit.intercept = std::log(mean_target / (1.0 - mean_target));
+    fit.flat = true;
+  }
+  return fit;
 }
 
 }  // namespace tod

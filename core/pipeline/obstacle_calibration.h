@@ -18,6 +18,10 @@ struct ObstacleCalibration {
   double intercept = 0.0;
   int samples = 0;    // components it was fitted on
   int positives = 0;  // of which covered a ground-truth obstacle
+  // True when the training components' evidence did not rank obstacles above the rest (the
+  // unconstrained fit's slope was negative): the fit is then held monotone at slope 0, so every
+  // obstacle scores the training frames' smoothed share of components on obstacles.
+  bool flat = false;
 };
 
 // The calibrated score of an obstacle with the given evidence.
@@ -26,6 +30,10 @@ double CalibratedScore(const ObstacleCalibration& calibration, double evidence);
 // Platt scaling: logistic regression of label on evidence by Newton's method, with Platt's
 // smoothed targets (N+ + 1) / (N+ + 2) and 1 / (N- + 2) so that a perfectly separated training
 // set does not drive the slope to infinity. Needs at least one positive and one negative.
+// The score must not fall as the evidence rises, so the slope is constrained to be >= 0: when
+// the unconstrained optimum is negative (few or unrepresentative training frames; seen on three
+// of eight 20-frame dev trainings), the constrained optimum is slope 0 and the intercept the
+// log-odds of the mean target (the log-likelihood is concave), reported as `flat`.
 Result<ObstacleCalibration> FitObstacleCalibration(const std::vector<double>& evidence,
                                                    const std::vector<int>& labels);
 

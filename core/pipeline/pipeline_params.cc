@@ -30,7 +30,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ProbabilityMapParams, min_score,
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PriorCorrection, edge_odds, occlusion_odds)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ForestScreening, trees, final_at_most)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ObstacleCalibration, fitted, slope, intercept,
-                                                samples, positives)
+                                                samples, positives, flat)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GroundPlaneFeatureParams, ground_plane_size,
                                                 horizon_y)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradient_edges,
@@ -61,6 +61,13 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
   }
   const Status boxes = ValidateEdgeBoxParams(p.boxes);
   if (!boxes.ok()) return Status::InvalidArgument("parameters: " + boxes.message());
+  const ObstacleCalibration& calibration = p.obstacle_calibration;
+  if (calibration.fitted && !(calibration.slope >= 0 && std::isfinite(calibration.slope) &&
+                              std::isfinite(calibration.intercept)))
+    return Status::InvalidArgument(
+        "parameters: obstacle_calibration.slope must be finite and >= 0 (a negative slope makes "
+        "an obstacle's score fall as its evidence rises; retrain the bundle), got " +
+        std::to_string(calibration.slope));
   if (p.regions.num_layers < 1 || p.superpixels.k < 1 || p.fusion.keep_ratio < 0 ||
       p.fusion.keep_ratio > 1 || p.probability_map.top_fraction < 0 ||
       p.probability_map.top_fraction > 1 || !(p.region_merge_iou > 0 && p.region_merge_iou <= 1) ||

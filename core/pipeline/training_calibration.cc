@@ -80,7 +80,16 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
                           {"folds", kFolds},
                           {"fold_layout", FoldLayoutName(run.options().fold_layout)},
                           {"components", fitted->samples},
-                          {"on_obstacles", fitted->positives}};
+                          {"on_obstacles", fitted->positives},
+                          {"flat", fitted->flat}};
+  if (fitted->flat) {
+    run.Say(
+        "WARNING: obstacle scores are flat: on the training frames, scored out of fold, the "
+        "fused scores did not rank the " +
+        std::to_string(fitted->positives) + " components on obstacles above the other " +
+        std::to_string(fitted->samples - fitted->positives) + "; every obstacle scores " +
+        std::to_string(CalibratedScore(*fitted, 0.0)) + " (train on more frames)");
+  }
   return Status::Ok();
 }
 

@@ -360,8 +360,10 @@ TEST_F(MasksCliTest, FoldLayoutIsBlocksByDefaultAlternateOnRequest) {
 
 // The map's isolation exponent (box_isolation.h) is fitted by default on the calibration's
 // out-of-fold maps: the manifest lists every candidate with its AP and the winner, which is the
-// exponent the bundle's parameters carry. --no-map-isolation keeps the paper's map.
-TEST_F(MasksCliTest, MapIsolationIsFittedByDefaultPaperMapOnRequest) {
+// exponent the bundle's parameters carry. --no-map-isolation keeps the paper's map. The same
+// out-of-fold components fit the obstacle calibration, which is held monotone (flat, never
+// inverted) and refused on load when a manifest inverts it.
+TEST_F(MasksCliTest, MapIsolationAndCalibrationFittedOutOfFoldPaperMapOnRequest) {
   const std::string fitted = (out_ / "fitted").string(), paper = (out_ / "paper").string();
   const CommandResult fitted_run = RunCommand(Train(fitted));
   ASSERT_EQ(fitted_run.exit_code, 0) << fitted_run.output;
@@ -407,6 +409,17 @@ TEST_F(MasksCliTest, MapIsolationIsFittedByDefaultPaperMapOnRequest) {
     ASSERT_FALSE(maps[exponent == 0 ? 0 : 1].empty());
   }
   EXPECT_GT(cv::norm(maps[0], maps[1], cv::NORM_L1), 0.0);
+
+  // The obstacle calibration says whether it was held flat; a bundle whose calibration would
+  // make a score fall as its evidence rises is refused by name, not served inverted.
+  EXPECT_TRUE(p["training"]["parts"]["calibration"]["flat"].is_boolean())
+      << p["training"]["parts"]["calibration"].dump();
+  const CommandResult inverted = DetectForged(
+      paper, "inverted_calibration",
+      [](nlohmann::json& m) { m["params"]["obstacle_calibration"]["slope"] = -3.7; }, image);
+  EXPECT_NE(inverted.exit_code, 0);
+  EXPECT_NE(inverted.output.find("obstacle_calibration.slope"), std::string::npos)
+      << inverted.output;
 }
 
 // The map weighs boxes by superpixel shares by default (probability_map.h); --no-map-shares

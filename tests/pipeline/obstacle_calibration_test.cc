@@ -37,6 +37,41 @@ TEST(ObstacleCalibrationTest, SeparableDataStaysFinite) {
   EXPECT_LT(CalibratedScore(*fit, 0.1), 0.5);
 }
 
+TEST(ObstacleCalibrationTest, EvidenceThatRanksObstaclesLastGivesAFlatNotAnInvertedScore) {
+  // Obstacles at low evidence, the rest at high: unconstrained, Platt's slope is negative and a
+  // stronger box would score lower. Held monotone, every evidence scores the smoothed base rate.
+  const std::vector<double> evidence = {0.1, 0.15, 0.2, 0.6, 0.7, 0.8, 0.9, 0.95};
+  const std::vector<int> labels = {1, 1, 0, 0, 0, 0, 0, 0};
+  auto fit = FitObstacleCalibration(evidence, labels);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_TRUE(fit->fitted);
+  EXPECT_TRUE(fit->flat);
+  EXPECT_EQ(fit->slope, 0.0);
+  const double hi = 3.0 / 4.0, lo = 1.0 / 8.0;  // Platt's targets for 2 positives, 6 negatives
+  const double base_rate = (2 * hi + 6 * lo) / 8.0;
+  EXPECT_NEAR(CalibratedScore(*fit, 0.1), base_rate, 1e-9);
+  EXPECT_NEAR(CalibratedScore(*fit, 0.95), base_rate, 1e-9);
+  // Evidence that does rank obstacles first is not flattened.
+  auto ranked = FitObstacleCalibration(evidence, {0, 0, 0, 0, 0, 0, 1, 1});
+  ASSERT_TRUE(ranked.ok());
+  EXPECT_FALSE(ranked->flat);
+  EXPECT_GT(ranked->slope, 0.0);
+}
+
+TEST(ObstacleCalibrationTest, ParametersWithANegativeSlopeAreRefused) {
+  PipelineParams params;
+  params.obstacle_calibration = {.fitted = true, .slope = -3.7, .intercept = 0.8};
+  const auto parsed = PipelineParamsFromJson(ToJson(params));
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_NE(parsed.status().message().find("obstacle_calibration.slope"), std::string::npos)
+      << parsed.status().message();
+  params.obstacle_calibration = {.fitted = true, .slope = 0.0, .intercept = -1.2, .flat = true};
+  const auto flat = PipelineParamsFromJson(ToJson(params));
+  ASSERT_TRUE(flat.ok()) << flat.status().message();
+  EXPECT_TRUE(flat->obstacle_calibration.flat);
+  EXPECT_DOUBLE_EQ(flat->obstacle_calibration.intercept, -1.2);
+}
+
 TEST(ObstacleCalibrationTest, NeedsBothClassesAndUnfittedPassesEvidenceThrough) {
   EXPECT_FALSE(FitObstacleCalibration({0.1, 0.2}, {1, 1}).ok());
   EXPECT_FALSE(FitObstacleCalibration({0.1, 0.2}, {0, 0}).ok());
