@@ -168,6 +168,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   report.frames = n - static_cast<int>(report.skipped.size());
   report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;
   report.map_superpixel_shares = bundle.params.probability_map.superpixel_shares;
+  report.calibration_flat = bundle.params.obstacle_calibration.flat;
   report.proposal_features = bundle.ordr.num_features();
   report.proposal_feature_set = ProposalFeatureSet(bundle.params);
   totals.Fill(report);
@@ -194,7 +195,8 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
                     {"obstacle_free_frames", a.obstacle_free_frames},
                     {"false_alarms_per_obstacle_free_frame",
                      per(a.false_alarms_on_obstacle_free, a.obstacle_free_frames)},
-                    {"instances_found", per(a.instances_found, r.instances)}};
+                    {"instances_found", per(a.instances_found, r.instances)},
+                    {"calibration_flat", r.calibration_flat}};
   j["free_space"] = r.free_space;
   j["map_isolation_exponent"] = r.map_isolation_exponent;
   j["map_superpixel_shares"] = r.map_superpixel_shares;
@@ -258,6 +260,9 @@ void FormatEvalSummary(const EvalReport& r, std::ostringstream& o) {
                 a.obstacle_free_frames,
                 r.instances ? static_cast<double>(a.instances_found) / r.instances : 0.0);
   o << text;
+  if (r.calibration_flat)
+    o << "obstacle calibration is flat: on its training frames the fused scores did not rank "
+         "obstacles first, so every obstacle scores alike (retrain on more frames)\n";
   for (const SkippedFrame& f : r.skipped)
     o << "skipped frame " << f.frame << ": " << f.reason << "\n";
 }

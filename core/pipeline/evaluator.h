@@ -77,6 +77,9 @@ struct EvalReport {
   // variants' maps weigh each box by isolation^this; 0 is the paper's map as published.
   float map_isolation_exponent = 0.f;
   bool map_superpixel_shares = false;  // the paper's map weighs boxes by superpixel shares
+  // The obstacle calibration was held flat in training (obstacle_calibration.h): every obstacle
+  // scores the same, so the calibrated map is the superpixel shares alone and none is reported.
+  bool calibration_flat = false;
   // The regressors' row width and which features they are (ProposalFeatureSet): the paper's 20,
   // with the vertical edge share and the orientation entropy when the bundle has them.
   int proposal_features = 0;

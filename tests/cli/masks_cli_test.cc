@@ -141,7 +141,7 @@ TEST_F(MasksCliTest, TrainAndEvalOnMaskBenchmarkLayout) {
   EXPECT_TRUE(j["calibrated_map"].contains("ap"));
   EXPECT_NE(eval.output.find("BP+Fusion@4 cal"), std::string::npos) << eval.output;
   for (const char* key : {"false_alarms_per_frame", "false_alarms_per_obstacle_free_frame",
-                          "obstacle_free_frames", "instances_found"})
+                          "obstacle_free_frames", "instances_found", "calibration_flat"})
     EXPECT_TRUE(j["obstacles"].contains(key)) << key;
 
   const std::string analysis_json = (out_ / "analysis.json").string();
@@ -420,6 +420,22 @@ TEST_F(MasksCliTest, MapIsolationAndCalibrationFittedOutOfFoldPaperMapOnRequest)
   EXPECT_NE(inverted.exit_code, 0);
   EXPECT_NE(inverted.output.find("obstacle_calibration.slope"), std::string::npos)
       << inverted.output;
+  // A flat calibration is served, and `tod eval` says so in its text and JSON.
+  const fs::path flat = out_ / "flat_calibration";
+  fs::copy(paper, flat, fs::copy_options::recursive);
+  nlohmann::json flat_manifest = Manifest(flat.string());
+  flat_manifest["params"]["obstacle_calibration"]["slope"] = 0.0;
+  flat_manifest["params"]["obstacle_calibration"]["flat"] = true;
+  std::ofstream(flat / "manifest.json") << flat_manifest.dump(2);
+  const std::string flat_json = (out_ / "flat_eval.json").string();
+  const CommandResult flat_eval =
+      RunCommand(tod_ + " eval --data " + Root() + " --split test --model " + flat.string() +
+                 " --json " + flat_json + " --threads 2");
+  ASSERT_EQ(flat_eval.exit_code, 0) << flat_eval.output;
+  EXPECT_NE(flat_eval.output.find("obstacle calibration is flat"), std::string::npos)
+      << flat_eval.output;
+  std::ifstream flat_in(flat_json);
+  EXPECT_EQ(nlohmann::json::parse(flat_in)["obstacles"]["calibration_flat"], true);
 }
 
 // The map weighs boxes by superpixel shares by default (probability_map.h); --no-map-shares
