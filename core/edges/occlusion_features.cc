@@ -203,6 +203,53 @@ float ChiSquaredDistance(const float* p, const float* q, int bins) {
 
 namespace {
 
+// The distinct positive labels around a pixel, sorted (at most 8).
+struct NeighbourLabels {
+  std::array<int, 9> labels{};  // 8 neighbours + the centre slot
+  int count = 0;
+  // Inserts t keeping `labels` sorted and distinct: the set does not depend on the order of the
+  // neighbours.
+  void Insert(int t) {
+    if (t <= 0) return;
+    int pos = 0;
+    while (pos < count && labels[pos] < t) ++pos;
+    if (pos < count && labels[pos] == t) return;
+    for (int m = count; m > pos; --m) labels[m] = labels[m - 1];
+    labels[pos] = t;
+    ++count;
+  }
+};
+
+// The labels of pixel (x, y)'s 8-neighbourhood; above / below are the neighbouring rows (null
+// outside the image).
+NeighbourLabels LabelsAround(const cv::Mat1i& labels, int x, int y, const int* above,
+                             const int* row, const int* below) {
+  NeighbourLabels seen;
+  if (above != nullptr && below != nullptr && x > 0 && x + 1 < labels.cols) {
+    // Interior pixel: the eight neighbours without bounds checks (the centre is 0).
+    seen.Insert(above[x - 1]);
+    seen.Insert(above[x]);
+    seen.Insert(above[x + 1]);
+    seen.Insert(row[x - 1]);
+    seen.Insert(row[x + 1]);
+    seen.Insert(below[x - 1]);
+    seen.Insert(below[x]);
+    seen.Insert(below[x + 1]);
+    return seen;
+  }
+  for (int dy = -1; dy <= 1; ++dy) {
+    const int yy = y + dy;
+    if (yy < 0 || yy >= labels.rows) continue;
+    const int* nrow = labels[yy];
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int xx = x + dx;
+      if (xx < 0 || xx >= labels.cols) continue;
+      seen.Insert(nrow[xx]);
+    }
+  }
+  return seen;
+}
+
 // Step 1: the boundary pixels, the pairs each borders (CSR, in `out`) and their coordinates.
 std::vector<cv::Point> ScanBoundaries(const Superpixels& superpixels, SuperpixelPairs& out) {
   const cv::Mat1i& labels = superpixels.labels;
@@ -231,45 +278,11 @@ std::vector<cv::Point> ScanBoundaries(const Superpixels& superpixels, Superpixel
     const int* below = y + 1 < height ? labels[y + 1] : nullptr;
     for (int x = 0; x < width; ++x) {
       if (row[x] != 0) continue;
-      std::array<int, 9> seen{};  // 8 neighbours + the centre slot
-      int num_seen = 0;
-      // Insert t keeping `seen` sorted and distinct (at most 8 entries); the set does not depend
-      // on the order of the neighbours.
-      auto insert = [&seen, &num_seen](int t) {
-        if (t <= 0) return;
-        int pos = 0;
-        while (pos < num_seen && seen[pos] < t) ++pos;
-        if (pos < num_seen && seen[pos] == t) return;
-        for (int m = num_seen; m > pos; --m) seen[m] = seen[m - 1];
-        seen[pos] = t;
-        ++num_seen;
-      };
-      if (above != nullptr && below != nullptr && x > 0 && x + 1 < width) {
-        // Interior pixel: the eight neighbours without bounds checks (the centre is 0).
-        insert(above[x - 1]);
-        insert(above[x]);
-        insert(above[x + 1]);
-        insert(row[x - 1]);
-        insert(row[x + 1]);
-        insert(below[x - 1]);
-        insert(below[x]);
-        insert(below[x + 1]);
-      } else {
-        for (int dy = -1; dy <= 1; ++dy) {
-          const int yy = y + dy;
-          if (yy < 0 || yy >= height) continue;
-          const int* nrow = labels[yy];
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int xx = x + dx;
-            if (xx < 0 || xx >= width) continue;
-            insert(nrow[xx]);
-          }
-        }
-      }
-      if (num_seen < 2) continue;
-      for (int i = 0; i < num_seen; ++i) {
-        for (int j = i + 1; j < num_seen; ++j) {
-          out.pixel_pairs.push_back(pair_index(seen[i], seen[j]));
+      const NeighbourLabels seen = LabelsAround(labels, x, y, above, row, below);
+      if (seen.count < 2) continue;
+      for (int i = 0; i < seen.count; ++i) {
+        for (int j = i + 1; j < seen.count; ++j) {
+          out.pixel_pairs.push_back(pair_index(seen.labels[i], seen.labels[j]));
         }
       }
       out.boundary_pixels.push_back(y * width + x);
