@@ -51,6 +51,51 @@ std::string NodeProblem(const ForestNode& node, std::uint64_t index, std::uint64
   return "";
 }
 
+// The counts of a forest file, checked against the limits, against each other and against the
+// bytes left in `in`, before anything is allocated for them.
+struct ForestCounts {
+  std::uint32_t features = 0;
+  std::uint32_t trees = 0;
+  std::uint64_t nodes = 0;
+};
+
+Result<ForestCounts> ReadForestCounts(BinaryReader& in) {
+  const auto corrupt = [&in](const std::string& problem) {
+    return in.Corrupt("random forest " + problem);
+  };
+  if (Status status = in.Header(kMagic, kVersion, "tod random forest"); !status.ok()) {
+    return status;
+  }
+  ForestCounts counts;
+  counts.features = in.U32("the feature count");
+  counts.trees = in.U32("the tree count");
+  counts.nodes = in.U64("the node count");
+  if (!in.ok()) return in.status();
+  if (counts.features > kMaxFeatures) {
+    return corrupt("header claims " + std::to_string(counts.features) + " features (limit " +
+                   std::to_string(kMaxFeatures) + ")");
+  }
+  if (counts.trees > kMaxTrees) {
+    return corrupt("header claims " + std::to_string(counts.trees) + " trees (limit " +
+                   std::to_string(kMaxTrees) + ")");
+  }
+  if (counts.nodes > kMaxNodes) {
+    return corrupt("header claims " + std::to_string(counts.nodes) + " nodes (limit " +
+                   std::to_string(kMaxNodes) + ")");
+  }
+  if (counts.nodes < counts.trees || (counts.trees > 0 && counts.features == 0) ||
+      (counts.trees == 0 && counts.nodes != 0)) {
+    return corrupt("header is inconsistent: " + std::to_string(counts.trees) + " trees, " +
+                   std::to_string(counts.nodes) + " nodes, " + std::to_string(counts.features) +
+                   " features");
+  }
+  // Within the limits the sum cannot overflow; a short file fails here, before any allocation.
+  const std::uint64_t body_bytes =
+      counts.trees * kRootBytes + counts.nodes * kNodeBytes + kChecksumBytes;
+  if (!in.Expect(body_bytes, 1, "the tree roots, nodes and checksum")) return in.status();
+  return counts;
+}
+
 }  // namespace
 
 Status RandomForest::Save(BinaryWriter& out) const {
@@ -74,34 +119,11 @@ Result<RandomForest> RandomForest::Load(BinaryReader& in) {
     return in.Corrupt("random forest " + problem);
   };
   const std::size_t start = in.position();
-  if (Status status = in.Header(kMagic, kVersion, "tod random forest"); !status.ok()) {
-    return status;
-  }
-  const std::uint32_t num_features = in.U32("the feature count");
-  const std::uint32_t num_trees = in.U32("the tree count");
-  const std::uint64_t num_nodes = in.U64("the node count");
-  if (!in.ok()) return in.status();
-  if (num_features > kMaxFeatures) {
-    return corrupt("header claims " + std::to_string(num_features) + " features (limit " +
-                   std::to_string(kMaxFeatures) + ")");
-  }
-  if (num_trees > kMaxTrees) {
-    return corrupt("header claims " + std::to_string(num_trees) + " trees (limit " +
-                   std::to_string(kMaxTrees) + ")");
-  }
-  if (num_nodes > kMaxNodes) {
-    return corrupt("header claims " + std::to_string(num_nodes) + " nodes (limit " +
-                   std::to_string(kMaxNodes) + ")");
-  }
-  if (num_nodes < num_trees || (num_trees > 0 && num_features == 0) ||
-      (num_trees == 0 && num_nodes != 0)) {
-    return corrupt("header is inconsistent: " + std::to_string(num_trees) + " trees, " +
-                   std::to_string(num_nodes) + " nodes, " + std::to_string(num_features) +
-                   " features");
-  }
-  // Within the limits the sum cannot overflow; a short file fails here, before any allocation.
-  const std::uint64_t body_bytes = num_trees * kRootBytes + num_nodes * kNodeBytes + kChecksumBytes;
-  if (!in.Expect(body_bytes, 1, "the tree roots, nodes and checksum")) return in.status();
+  const Result<ForestCounts> counts = ReadForestCounts(in);
+  if (!counts.ok()) return counts.status();
+  const std::uint32_t num_features = counts->features;
+  const std::uint32_t num_trees = counts->trees;
+  const std::uint64_t num_nodes = counts->nodes;
 
   RandomForest forest;
   forest.num_features_ = static_cast<int>(num_features);
