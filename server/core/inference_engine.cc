@@ -168,42 +168,40 @@ void InferenceEngine::Finish(Completion& done, InferenceResult result,
   done(std::move(result));
 }
 
-void InferenceEngine::Submit(const InferenceRequest& request, Completion done) {
-  const Clock::time_point submitted = Clock::now();
-  // Cheap checks first, so a request that can never succeed does not take a queue slot.
+std::optional<InferenceResult> InferenceEngine::AdmissionRefusal(
+    const InferenceRequest& request) const {
   if (!Ready()) {
-    Finish(done,
-           Refusal(Status::Unavailable(draining() ? "server is shutting down; retry elsewhere"
+    return Refusal(Status::Unavailable(draining() ? "server is shutting down; retry elsewhere"
                                                   : "model not loaded yet; retry shortly"),
-                   Rejection::kNotReady),
-           submitted);
-    return;
+                   Rejection::kNotReady);
   }
   if (Status valid = ValidateOptions(request.options); !valid.ok()) {
-    Finish(done, Refusal(std::move(valid), Rejection::kBadRequest), submitted);
-    return;
+    return Refusal(std::move(valid), Rejection::kBadRequest);
   }
   if (request.image.size() > config_.limits.max_bytes) {
-    Finish(done,
-           Refusal(Status::ResourceExhausted("image: " + std::to_string(request.image.size()) +
+    return Refusal(Status::ResourceExhausted("image: " + std::to_string(request.image.size()) +
                                              " bytes is over the limit of " +
                                              std::to_string(config_.limits.max_bytes) + " bytes"),
-                   Rejection::kTooLarge),
-           submitted);
-    return;
+                   Rejection::kTooLarge);
   }
-  if (Result<ImageHeader> header = PeekImageHeader(request.image); !header.ok()) {
-    Finish(done, Refusal(header.status(), Rejection::kBadImage), submitted);
-    return;
-  } else if (static_cast<long long>(header->size.width) * header->size.height >
-             config_.limits.max_pixels) {
-    Finish(done,
-           Refusal(Status::ResourceExhausted("image: " + std::to_string(header->size.width) + "x" +
+  const Result<ImageHeader> header = PeekImageHeader(request.image);
+  if (!header.ok()) return Refusal(header.status(), Rejection::kBadImage);
+  if (static_cast<long long>(header->size.width) * header->size.height >
+      config_.limits.max_pixels) {
+    return Refusal(Status::ResourceExhausted("image: " + std::to_string(header->size.width) + "x" +
                                              std::to_string(header->size.height) +
                                              " pixels is over the limit of " +
                                              std::to_string(config_.limits.max_pixels) + " pixels"),
-                   Rejection::kTooLarge),
-           submitted);
+                   Rejection::kTooLarge);
+  }
+  return std::nullopt;
+}
+
+void InferenceEngine::Submit(const InferenceRequest& request, Completion done) {
+  const Clock::time_point submitted = Clock::now();
+  // Cheap checks first, so a request that can never succeed does not take a queue slot.
+  if (std::optional<InferenceResult> refusal = AdmissionRefusal(request)) {
+    Finish(done, std::move(*refusal), submitted);
     return;
   }
   {

@@ -126,6 +126,9 @@ class InferenceEngine {
   InferenceResult Run(const Job& job) const;
   void Finish(Completion& done, InferenceResult result, Clock::time_point submitted) const;
   Status ValidateOptions(const DetectOptions& options) const;
+  // Why `request` is refused before it takes a queue slot (not ready, bad options, over the
+  // byte or pixel limits, not an image), or nothing.
+  std::optional<InferenceResult> AdmissionRefusal(const InferenceRequest& request) const;
 
   const EngineConfig config_;
   const ModelHolder& models_;
