@@ -275,16 +275,8 @@ cv::Vec3f ObstacleColour(SynthShape shape, const cv::Vec3f& road, Rng& rng) {
   return rng.Pick(kPalette) * static_cast<float>(rng.Uniform(0.8, 1.15));
 }
 
-SynthObstacleSpec SampleOne(const SynthParams& p, const SceneLayout& layout, Rng& rng) {
-  SynthObstacleSpec s;
-  const double u = rng.Unit();
-  s.shape = u < 0.3    ? SynthShape::kBox
-            : u < 0.42 ? SynthShape::kCylinder
-            : u < 0.52 ? SynthShape::kTyreStanding
-            : u < 0.6  ? SynthShape::kTyreLying
-            : u < 0.72 ? SynthShape::kBall
-                       : SynthShape::kIrregular;
-  const double size = rng.LogUniform(p.min_size_m, p.max_size_m);  // largest dimension
+// The obstacle's width, depth and height in metres for its shape, `size` its largest dimension.
+void SampleDimensions(double size, Rng& rng, SynthObstacleSpec& s) {
   switch (s.shape) {
     case SynthShape::kBox:
       switch (rng.UniformInt(0, 3)) {
@@ -330,6 +322,19 @@ SynthObstacleSpec SampleOne(const SynthParams& p, const SceneLayout& layout, Rng
       s.depth_m = s.width_m * rng.Uniform(0.3, 1.0);
       break;
   }
+}
+
+SynthObstacleSpec SampleOne(const SynthParams& p, const SceneLayout& layout, Rng& rng) {
+  SynthObstacleSpec s;
+  const double u = rng.Unit();
+  s.shape = u < 0.3    ? SynthShape::kBox
+            : u < 0.42 ? SynthShape::kCylinder
+            : u < 0.52 ? SynthShape::kTyreStanding
+            : u < 0.6  ? SynthShape::kTyreLying
+            : u < 0.72 ? SynthShape::kBall
+                       : SynthShape::kIrregular;
+  const double size = rng.LogUniform(p.min_size_m, p.max_size_m);  // largest dimension
+  SampleDimensions(size, rng, s);
   s.yaw_rad = rng.Uniform(-CV_PI, CV_PI);
   const double bottom_m = layout.camera.GroundDistanceAtRow(layout.size.height);
   const double z_lo =
