@@ -109,6 +109,11 @@ Result<SparseEdgeMap> SparseEdgeMap::Build(const cv::Mat1f& region_map) {
     }
   }
 
+  out.DecideExactSums(pixels_of_id);
+  return out;
+}
+
+void SparseEdgeMap::DecideExactSums(const std::vector<std::int64_t>& pixels_of_id) {
   // Exactness of the sums (see the header). q = the smallest ulp among the values (a float of
   // exponent e is a multiple of 2^(e - 23); subnormals of 2^-149); every value is then an integer
   // number of q's, and if the map's total |M| is at most 2^53 q, no double partial sum of any
@@ -118,30 +123,29 @@ Result<SparseEdgeMap> SparseEdgeMap::Build(const cv::Mat1f& region_map) {
   constexpr int kMinQuantumExponent =
       std::numeric_limits<float>::min_exponent - std::numeric_limits<float>::digits;  // -149
   int quantum_exponent = std::numeric_limits<int>::max();
-  for (const float value : out.values_) {
+  for (const float value : values_) {
     quantum_exponent = std::min(quantum_exponent,
                                 std::max(std::ilogb(value) - kFloatFraction, kMinQuantumExponent));
   }
-  out.sums_exact_ = true;
-  out.units_.resize(out.values_.size());
+  sums_exact_ = true;
+  units_.resize(values_.size());
   std::int64_t total_units = 0;  // sum of |M| / q over the map, checked against kExactLimit
-  for (std::size_t id = 0; id < out.values_.size() && out.sums_exact_; ++id) {
-    const double units = std::ldexp(static_cast<double>(out.values_[id]), -quantum_exponent);
+  for (std::size_t id = 0; id < values_.size() && sums_exact_; ++id) {
+    const double units = std::ldexp(static_cast<double>(values_[id]), -quantum_exponent);
     const double magnitude = std::abs(units);
     if (magnitude > static_cast<double>(kExactLimit) ||
         static_cast<std::int64_t>(magnitude) > (kExactLimit - total_units) / pixels_of_id[id]) {
-      out.sums_exact_ = false;
+      sums_exact_ = false;
       break;
     }
-    out.units_[id] = static_cast<std::int64_t>(units);  // an integer: no rounding
+    units_[id] = static_cast<std::int64_t>(units);  // an integer: no rounding
     total_units += static_cast<std::int64_t>(magnitude) * pixels_of_id[id];
   }
-  if (!out.sums_exact_) {
-    out.units_.clear();
-  } else if (!out.values_.empty()) {
-    out.quantum_ = std::ldexp(1.0, quantum_exponent);
+  if (!sums_exact_) {
+    units_.clear();
+  } else if (!values_.empty()) {
+    quantum_ = std::ldexp(1.0, quantum_exponent);
   }
-  return out;
 }
 
 int SparseEdgeMap::FirstRunAfter(int y, int x) const {

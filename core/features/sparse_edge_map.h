@@ -58,6 +58,9 @@ class SparseEdgeMap {
     int id;     // index into values_
   };
 
+  // Sets units_, quantum_ and sums_exact_: whether every box sum can be taken exactly in integer
+  // units of the smallest ulp among values_ (pixels_of_id[id]: the map's pixels of value id).
+  void DecideExactSums(const std::vector<std::int64_t>& pixels_of_id);
   // First run of row y that ends after column x (x inside the map).
   int FirstRunAfter(int y, int x) const;
   // The original (band-major, pixel by pixel) double sums; the fallback when !sums_exact_.
