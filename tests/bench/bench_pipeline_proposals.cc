@@ -57,6 +57,74 @@ void Add(Totals& t, const tod::EdgeBoxStats& s, long long kept) {
   t.kept += kept;
 }
 
+// One region scored once under one configuration: its time, counts and the boxes through the
+// size filter (null: no filter); every returned box and score is folded into `digest`.
+struct RegionRun {
+  double ms = 0.0;
+  tod::EdgeBoxStats stats;
+  long long kept = 0;
+};
+
+RegionRun ScoreRegion(const cv::Mat1f& map, const tod::EdgeBoxParams& params,
+                      const tod::WindowAdmission* admission, const tod::SizeFilter* filter,
+                      const tod::Box& region, std::uint64_t& digest) {
+  RegionRun run;
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<tod::ScoredBox> boxes = tod::ScoreEdgeBoxes(map, params, &run.stats, admission);
+  run.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  for (const tod::ScoredBox& b : boxes) {
+    for (const int v : {b.box.x, b.box.y, b.box.w, b.box.h, static_cast<int>(b.score * 1e7f)})
+      digest = (digest ^ static_cast<std::uint64_t>(v)) * 1099511628211ull;
+  }
+  for (tod::ScoredBox b : boxes) {
+    b.box.y += region.y;
+    b.box.x += region.x;
+    run.kept += filter == nullptr || filter->Keep(b.box);
+  }
+  return run;
+}
+
+// The configurations side by side: median ms, speed-up over the paper's, counts per frame.
+void PrintConfigTable(const std::vector<Config>& configs, const std::vector<Totals>& totals,
+                      const tod::SynthParams& synth, int frames, int layers) {
+  std::printf("frame %dx%d, %d frames, one core; counts per frame (mean), times median\n",
+              synth.width, synth.height, frames);
+  std::printf(
+      "| configuration | ms | vs paper | windows scored | walks | refined | kept boxes | rescanned "
+      "regions | digest |\n"
+      "|---|---|---|---|---|---|---|---|---|\n");
+  const double paper_ms = Median(totals[0].ms);
+  for (size_t c = 0; c < configs.size(); ++c) {
+    const Totals& t = totals[c];
+    const double ms = Median(t.ms);
+    std::printf("| %s | %.1f | %.2fx | %lld | %lld | %lld | %lld | %lld of %d | %016llx |\n",
+                configs[c].name.c_str(), ms, ms > 0 ? paper_ms / ms : 0.0,
+                t.stats.windows_visited / frames, t.stats.scorings / frames,
+                t.stats.windows_refined / frames, t.kept / frames, t.stats.rescans, frames * layers,
+                static_cast<unsigned long long>(t.digest));
+  }
+}
+
+// The model's own configuration region by region.
+void PrintRegionTable(const std::string& name, const std::vector<Totals>& region_totals,
+                      const std::vector<cv::Size>& region_sizes, bool multistride, int frames) {
+  const int layers = static_cast<int>(region_totals.size());
+  std::printf("\nper region, %s\n", name.c_str());
+  std::printf(
+      "| region | map | stride factor | windows scored | walks | refined | kept boxes | ms |\n"
+      "|---|---|---|---|---|---|---|---|\n");
+  for (int k = 0; k < layers; ++k) {
+    const Totals& r = region_totals[static_cast<size_t>(k)];
+    const cv::Size size = region_sizes[static_cast<size_t>(k)];
+    std::printf("| R%d | %dx%d | %.2f | %lld | %lld | %lld | %lld | %.1f |\n", k + 1, size.width,
+                size.height,
+                multistride ? static_cast<double>(layers - k) / static_cast<double>(layers) : 1.0,
+                r.stats.windows_visited / frames, r.stats.scorings / frames,
+                r.stats.windows_refined / frames, r.kept / frames, Median(r.ms));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -113,65 +181,22 @@ int main(int argc, char** argv) {
       for (size_t c = 0; c < configs.size(); ++c) {
         params.refine_local_maxima = configs[c].local_maxima;
         params.refine_limit = configs[c].refine_limit;
-        tod::EdgeBoxStats stats;
-        const auto start = std::chrono::steady_clock::now();
-        const std::vector<tod::ScoredBox> boxes = tod::ScoreEdgeBoxes(
-            map, params, &stats, configs[c].admission && filtered ? &admission : nullptr);
-        const double ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count();
-        long long kept = 0;
-        std::uint64_t& digest = config_totals[c].digest;
-        for (const tod::ScoredBox& b : boxes) {
-          for (const int v : {b.box.x, b.box.y, b.box.w, b.box.h, static_cast<int>(b.score * 1e7f)})
-            digest = (digest ^ static_cast<std::uint64_t>(v)) * 1099511628211ull;
-        }
-        for (tod::ScoredBox b : boxes) {
-          b.box.y += region.y;
-          b.box.x += region.x;
-          kept += !filtered || filter.Keep(b.box);
-        }
-        frame_ms[c] += ms;
-        Add(config_totals[c], stats, kept);
+        const RegionRun run =
+            ScoreRegion(map, params, configs[c].admission && filtered ? &admission : nullptr,
+                        filtered ? &filter : nullptr, region, config_totals[c].digest);
+        frame_ms[c] += run.ms;
+        Add(config_totals[c], run.stats, run.kept);
         if (c + 1 == configs.size()) {
           Totals& r = region_totals[static_cast<size_t>(k)];
-          Add(r, stats, kept);
-          r.ms.push_back(ms);
+          Add(r, run.stats, run.kept);
+          r.ms.push_back(run.ms);
         }
       }
     }
     for (size_t c = 0; c < configs.size(); ++c) config_totals[c].ms.push_back(frame_ms[c]);
   }
-  std::printf("frame %dx%d, %d frames, one core; counts per frame (mean), times median\n",
-              synth.width, synth.height, frames);
-  std::printf(
-      "| configuration | ms | vs paper | windows scored | walks | refined | kept boxes | rescanned "
-      "regions | digest |\n"
-      "|---|---|---|---|---|---|---|---|---|\n");
-  const double paper_ms = Median(config_totals[0].ms);
-  for (size_t c = 0; c < configs.size(); ++c) {
-    const Totals& t = config_totals[c];
-    const double ms = Median(t.ms);
-    std::printf("| %s | %.1f | %.2fx | %lld | %lld | %lld | %lld | %lld of %d | %016llx |\n",
-                configs[c].name.c_str(), ms, ms > 0 ? paper_ms / ms : 0.0,
-                t.stats.windows_visited / frames, t.stats.scorings / frames,
-                t.stats.windows_refined / frames, t.kept / frames, t.stats.rescans, frames * layers,
-                static_cast<unsigned long long>(t.digest));
-  }
-  std::printf("\nper region, %s\n", configs.back().name.c_str());
-  std::printf(
-      "| region | map | stride factor | windows scored | walks | refined | kept boxes | ms |\n"
-      "|---|---|---|---|---|---|---|---|\n");
-  for (int k = 0; k < layers; ++k) {
-    const Totals& r = region_totals[static_cast<size_t>(k)];
-    const cv::Size size = region_sizes[static_cast<size_t>(k)];
-    std::printf("| R%d | %dx%d | %.2f | %lld | %lld | %lld | %lld | %.1f |\n", k + 1, size.width,
-                size.height,
-                bundle->params.multistride
-                    ? static_cast<double>(layers - k) / static_cast<double>(layers)
-                    : 1.0,
-                r.stats.windows_visited / frames, r.stats.scorings / frames,
-                r.stats.windows_refined / frames, r.kept / frames, Median(r.ms));
-  }
+  PrintConfigTable(configs, config_totals, synth, frames, layers);
+  PrintRegionTable(configs.back().name, region_totals, region_sizes, bundle->params.multistride,
+                   frames);
   return 0;
 }
