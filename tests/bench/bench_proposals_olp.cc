@@ -173,6 +173,42 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// `repeats` scorings of one map: the last one's boxes and counts, every one's wall and CPU ms.
+struct TimedScoring {
+  tod::EdgeBoxStats stats;
+  std::vector<tod::ScoredBox> boxes;
+  std::vector<double> wall_ms, cpu_ms;
+};
+
+TimedScoring ScoreRepeatedly(const cv::Mat1f& map, const tod::EdgeBoxParams& params, int repeats) {
+  TimedScoring out;
+  for (int i = 0; i < repeats; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t c0 = std::clock();
+    out.boxes = tod::ScoreEdgeBoxes(map, params, &out.stats);
+    const std::clock_t c1 = std::clock();
+    const auto t1 = std::chrono::steady_clock::now();
+    out.wall_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    out.cpu_ms.push_back(1000.0 * static_cast<double>(c1 - c0) / CLOCKS_PER_SEC);
+  }
+  return out;
+}
+
+// What refining only refine_limit windows costs in recall against refining every one.
+void PrintRefineRecall(const cv::Mat1f& map, const tod::EdgeBoxParams& params,
+                       const std::vector<tod::Box>& objects,
+                       const std::vector<tod::ScoredBox>& limited) {
+  tod::EdgeBoxParams exact_params = params;
+  exact_params.refine_limit = 0;
+  const auto exact = tod::ScoreEdgeBoxes(map, exact_params);
+  std::printf(
+      "       %zu objects, top-1000 recall@0.5 %.2f -> %.2f, @0.7 %.2f -> %.2f, "
+      "exact top-1000 kept %.3f\n",
+      objects.size(), Recall(objects, exact, 1000, 0.5), Recall(objects, limited, 1000, 0.5),
+      Recall(objects, exact, 1000, 0.7), Recall(objects, limited, 1000, 0.7),
+      SameTop(exact, limited, 1000));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -212,21 +248,12 @@ int main(int argc, char** argv) {
       params.stride_factor = region.ms_factor;
       params.threads = threads;
       params.refine_limit = refine_limit;
-      tod::EdgeBoxStats stats;
-      std::uint64_t digest = 0;
-      std::vector<tod::ScoredBox> last;
-      std::vector<double> wall_ms, cpu_ms;
-      for (int i = 0; i < repeats; ++i) {
-        const auto t0 = std::chrono::steady_clock::now();
-        const std::clock_t c0 = std::clock();
-        const auto boxes = tod::ScoreEdgeBoxes(map, params, &stats);
-        const std::clock_t c1 = std::clock();
-        const auto t1 = std::chrono::steady_clock::now();
-        wall_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-        cpu_ms.push_back(1000.0 * static_cast<double>(c1 - c0) / CLOCKS_PER_SEC);
-        digest = Digest(boxes);
-        last = boxes;
-      }
+      const TimedScoring timed = ScoreRepeatedly(map, params, repeats);
+      const tod::EdgeBoxStats& stats = timed.stats;
+      const std::vector<tod::ScoredBox>& last = timed.boxes;
+      const std::uint64_t digest = Digest(last);
+      const std::vector<double>& cpu_ms = timed.cpu_ms;
+      const std::vector<double>& wall_ms = timed.wall_ms;
       // CPU time is what the budget is about on a shared machine (it sums over threads).
       cpu_total += Median(cpu_ms);
       wall_total += Median(wall_ms);
@@ -236,17 +263,7 @@ int main(int argc, char** argv) {
           stats.windows_visited, stats.windows_past_early_exit, stats.windows_nonzero,
           stats.scorings, stats.boxes_out, Median(cpu_ms), Median(wall_ms),
           static_cast<unsigned long long>(digest));
-      if (refine_limit > 0 && !objects.empty()) {
-        tod::EdgeBoxParams exact_params = params;
-        exact_params.refine_limit = 0;
-        const auto exact = tod::ScoreEdgeBoxes(map, exact_params);
-        std::printf(
-            "       %zu objects, top-1000 recall@0.5 %.2f -> %.2f, @0.7 %.2f -> %.2f, "
-            "exact top-1000 kept %.3f\n",
-            objects.size(), Recall(objects, exact, 1000, 0.5), Recall(objects, last, 1000, 0.5),
-            Recall(objects, exact, 1000, 0.7), Recall(objects, last, 1000, 0.7),
-            SameTop(exact, last, 1000));
-      }
+      if (refine_limit > 0 && !objects.empty()) PrintRefineRecall(map, params, objects, last);
     }
     std::printf("%-6s total: %.1f ms CPU, %.1f ms wall\n", kind.name, cpu_total, wall_total);
   }
