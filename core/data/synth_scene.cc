@@ -179,11 +179,12 @@ SceneLayout SampleLayout(const SynthParams& params, Rng& rng) {
   return layout;
 }
 
-void DrawSkyAndGround(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
+namespace {
+
+// The sky above the horizon row: the layout's gradient, modulated by the canvas detail noise.
+void DrawSky(Canvas& canvas, const SceneLayout& layout, int horizon, float cloud_amp) {
   const PinholeCamera& cam = layout.camera;
-  const int rows = canvas.colour.rows, cols = canvas.colour.cols;
-  const int horizon = std::clamp(static_cast<int>(std::ceil(cam.horizon_row)), 0, rows);
-  const float cloud_amp = static_cast<float>(rng.Uniform(0.02, 0.12));
+  const int cols = canvas.colour.cols;
   for (int y = 0; y < horizon; ++y) {
     const float t = static_cast<float>(std::pow((y + 0.5) / std::max(1.0, cam.horizon_row), 0.7));
     const cv::Vec3f sky = layout.sky_top * (1.0f - t) + layout.sky_horizon * t;
@@ -191,6 +192,15 @@ void DrawSkyAndGround(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
     const float* d = canvas.detail.ptr<float>(y);
     for (int x = 0; x < cols; ++x) c[x] = sky * (1.0f + cloud_amp * d[x]);
   }
+}
+
+}  // namespace
+
+void DrawSkyAndGround(Canvas& canvas, const SceneLayout& layout, Rng& rng) {
+  const PinholeCamera& cam = layout.camera;
+  const int rows = canvas.colour.rows;
+  const int horizon = std::clamp(static_cast<int>(std::ceil(cam.horizon_row)), 0, rows);
+  DrawSky(canvas, layout, horizon, static_cast<float>(rng.Uniform(0.02, 0.12)));
   // Everything below the horizon starts as far ground; nearer surfaces are painted over it.
   canvas.surface.rowRange(horizon, rows).setTo(static_cast<uchar>(Surface::kFarGround));
 
