@@ -262,6 +262,28 @@ void Drain(const ServerConfig& config, InferenceEngine& engine, grpc::Server& gr
   LogEvent(spdlog::level::info, "stopped", {{"drained", drained}});
 }
 
+// The HTTP front end's settings, with the HTTPS context when TLS is on.
+Result<HttpFrontendConfig> HttpConfigWithTls(const ServerConfig& config, const Security& security) {
+  HttpFrontendConfig http_config = HttpConfigFrom(config, security);
+  if (security.tls) {
+    Result<std::shared_ptr<boost::asio::ssl::context>> https = HttpsContext(*security.tls);
+    if (!https.ok()) return https.status();
+    http_config.tls = std::move(*https);
+  }
+  return http_config;
+}
+
+void LogListening(const ServerConfig& config, const Security& security, int grpc_port,
+                  int http_port) {
+  LogEvent(spdlog::level::info, "listening",
+           {{"grpc", config.host + ":" + std::to_string(grpc_port)},
+            {"http", config.host + ":" + std::to_string(http_port)},
+            {"tls", !security.tls            ? "off"
+                    : security.tls->mutual() ? "mutual"
+                                             : "on"},
+            {"auth", security.auth ? "bearer" : "off"}});
+}
+
 }  // namespace
 
 void BlockServerSignals() {
@@ -293,29 +315,19 @@ int RunServer(const ServerConfig& config) {
               << " (port in use or not permitted)\n";
     return 1;
   }
-  HttpFrontendConfig http_config = HttpConfigFrom(config, security);
-  if (security.tls) {
-    Result<std::shared_ptr<boost::asio::ssl::context>> https = HttpsContext(*security.tls);
-    if (!https.ok()) {  // LoadTlsMaterial built one already; this cannot fail differently
-      std::cerr << "tod_server: " << https.status().message() << "\n";
-      grpc_server->Shutdown();
-      return 2;
-    }
-    http_config.tls = std::move(*https);
+  Result<HttpFrontendConfig> http_config = HttpConfigWithTls(config, security);
+  if (!http_config.ok()) {  // LoadTlsMaterial built one already; this cannot fail differently
+    std::cerr << "tod_server: " << http_config.status().message() << "\n";
+    grpc_server->Shutdown();
+    return 2;
   }
-  HttpFrontend http(http_config, engine, models, metrics);
+  HttpFrontend http(*http_config, engine, models, metrics);
   if (Status bound = http.Bind(config.host, config.http_port); !bound.ok()) {
     grpc_server->Shutdown();
     return Refuse("cannot listen for HTTP", bound.message(), bound.message(), 1);
   }
   http.Start();
-  LogEvent(spdlog::level::info, "listening",
-           {{"grpc", config.host + ":" + std::to_string(grpc_port)},
-            {"http", config.host + ":" + std::to_string(http.port())},
-            {"tls", !security.tls            ? "off"
-                    : security.tls->mutual() ? "mutual"
-                                             : "on"},
-            {"auth", security.auth ? "bearer" : "off"}});
+  LogListening(config, security, grpc_port, http.port());
 
   if (Status loaded = models.Load(config.model_dir); !loaded.ok()) {
     http.Stop();
