@@ -83,6 +83,10 @@ void AddRegressorOptions(CLI::App* cmd, TrainArgs& args) {
                   "of other frames of its fold pasted in at their own rows, shifted sideways "
                   "(0 = the frames as they are)")
       ->check(CLI::Range(0, 8));
+  cmd->add_flag("--truth-box-positives,!--no-truth-box-positives", args.train.truth_box_positives,
+                "regressors: every training obstacle's own box, in each region that holds it, is "
+                "one more positive beside the proposals that overlap it best (the default; "
+                "--no-truth-box-positives: the paper's positives alone)");
   cmd->add_option("--negative-bags", args.train.selection.negative_bags,
                   "regressors: draw the negatives N times (disjoint draws of the paper's counts) "
                   "and fit each regressor as N forests of trees/N, each on every positive and "

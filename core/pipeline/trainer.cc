@@ -47,6 +47,7 @@ nlohmann::json RegressorPartRecord(const std::string& name, const TrainOptions& 
           {"negative_bags", options.selection.negative_bags},
           {"hard_fraction", options.selection.hard_fraction},
           {"pasted_copies", options.pasted_copies},
+          {"truth_box_positives", options.truth_box_positives},
           {"features", num_features},
           {"maps", folds.enabled ? "out_of_fold" : "in_sample"},
           {"fold_layout", FoldLayoutName(options.fold_layout)}};

@@ -69,6 +69,12 @@ struct TrainOptions {
   // its fold pasted in (0 = the frames as they are). Only the regressors' samples: the edge and
   // occlusion classifiers, the calibration and the map's fit see the real frames alone.
   int pasted_copies = 0;
+  // Truth boxes as positives (not in the paper; README "Real frames"): every training obstacle's
+  // own box, in each region that holds it, is one more positive of both regressors beside the
+  // proposals that overlap it best, so the forests see what a box framing an obstacle exactly
+  // looks like even where the proposal stage found none.
+  // false: the paper's positives alone.
+  bool truth_box_positives = true;
   PasteParams paste;
   // Stacked training (not in the paper; README "Real frames"): the maps a learned part trains on
   // (edge maps for the occlusion classifier; edge and occlusion maps for the regressors and the

@@ -4,12 +4,14 @@
 #include <string>
 
 #include "core/data/pasted_obstacles.h"
+#include "core/features/mask_iou.h"
 #include "core/features/sample_selection.h"
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/probability_map.h"
 #include "core/pipeline/proposal_features.h"
 #include "core/pipeline/proposal_regression.h"
+#include "core/pipeline/truth_boxes.h"
 
 namespace tod::training {
 namespace {
@@ -43,6 +45,31 @@ struct FrameRows {
   }
 };
 
+// The rows of TruthBoxes, appended to both regressors' rows as positives of every bag, with the
+// targets the selection gives (mask IoU, or box IoU with SampleSelectionParams::box_iou_target).
+Status AppendTruthBoxes(const Sample& s, const OcclusionEdges& oaocc, const ModelBundle& bundle,
+                        const SampleSelectionParams& selection, const BoxFeatureOptions& features,
+                        FrameRows& rows) {
+  const ProposalSet truth =
+      TruthBoxes(s.instances, oaocc, bundle.regions, bundle.params.boxes,
+                 DetectorProposalOptions(bundle.params, bundle.regions.num_layers()).multistride);
+  if (truth.boxes.empty()) return Status::Ok();
+  auto table = MaskIoUTable::Build(s.instances);
+  if (!table.ok()) return table.status();
+  const cv::Mat1f x = ComputeProposalFeatures(s.image, oaocc, bundle.regions, truth, features);
+  for (const ScoredBox& b : truth.boxes) {
+    const float target = static_cast<float>(selection.box_iou_target ? table->MaxBoxIoU(b.box)
+                                                                     : table->MaxIoU(b.box));
+    rows.ordr_targets.push_back(target);
+    rows.obdr_targets.push_back(target);
+    rows.ordr_bags.push_back(SelectedSamples::kEveryBag);
+    rows.obdr_bags.push_back(SelectedSamples::kEveryBag);
+  }
+  rows.ordr.push_back(x);
+  rows.obdr.push_back(x);
+  return Status::Ok();
+}
+
 // §6 on one frame: its proposals (maps by `upstream`'s classifiers), ranked by objectness or, with
 // `miner`, by the miner's fused score; the selected samples' features and targets. With
 // `positives_only` (a pasted copy: its negatives would be the frame's road again) the negatives
@@ -50,7 +77,7 @@ struct FrameRows {
 Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundle,
                                        const ModelBundle& upstream, const ModelBundle* miner,
                                        const SampleSelectionParams& selection, std::uint64_t seed,
-                                       bool positives_only) {
+                                       bool positives_only, bool truth_boxes) {
   const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
       s.image, bundle.regions, *upstream.edges, &upstream.occlusion,
       OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), upstream.params, true);
@@ -87,6 +114,10 @@ Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundl
   rows.ordr_bags = std::move(selected->ordr_bags);
   rows.obdr_bags = std::move(selected->obdr_bags);
   rows.proposals = static_cast<long long>(all.boxes.size());
+  if (truth_boxes) {
+    if (Status st = AppendTruthBoxes(s, oaocc, bundle, selection, features, rows); !st.ok())
+      return st;
+  }
   return rows;
 }
 
@@ -123,7 +154,7 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
           const ModelBundle& upstream = folds.For(bundle, i);
           const std::uint64_t seed = options.seed * 1000003ULL + static_cast<unsigned>(i);
           auto rows = RegressorRowsOfFrame(s, bundle, upstream, miner, options.selection, seed,
-                                           /*positives_only=*/false);
+                                           /*positives_only=*/false, options.truth_box_positives);
           if (!rows.ok()) return rows.status();
           const std::vector<const ObstacleCutout*> donors =
               options.pasted_copies > 0 ? DonorsFor(i, survey, folds)
@@ -133,8 +164,9 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
             Sample pasted = PasteObstacles(s, donors, copy_seed, options.paste);
             if (pasted.instances.size() == s.instances.size()) continue;  // no place was free
             VoidOwnObstacles(pasted, s.instances.size());
-            auto more = RegressorRowsOfFrame(pasted, bundle, upstream, miner, options.selection,
-                                             copy_seed, /*positives_only=*/true);
+            auto more =
+                RegressorRowsOfFrame(pasted, bundle, upstream, miner, options.selection, copy_seed,
+                                     /*positives_only=*/true, options.truth_box_positives);
             if (!more.ok()) return more.status().WithContext("pasted copy " + std::to_string(copy));
             rows->Append(*more);
           }

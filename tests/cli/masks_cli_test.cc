@@ -594,6 +594,32 @@ TEST_F(MasksCliTest, OrientationEntropyFeatureOnRequest) {
 
 }  // namespace
 
+// Truth boxes as positives (the default): every training obstacle's own box is one more positive
+// of both regressors. Recorded per regressor; without them (--no-truth-box-positives) each
+// regressor has fewer samples, its proposals the same; the bundle detects.
+TEST_F(MasksCliTest, TruthBoxesAddPositivesUnlessTurnedOff) {
+  const std::string with_truth = (out_ / "truth").string();
+  const std::string paper = (out_ / "paper").string();
+  const CommandResult run_truth = RunCommand(Train(with_truth));
+  ASSERT_EQ(run_truth.exit_code, 0) << run_truth.output;
+  const CommandResult run_paper = RunCommand(Train(paper, "--no-truth-box-positives"));
+  ASSERT_EQ(run_paper.exit_code, 0) << run_paper.output;
+  const nlohmann::json with = Manifest(with_truth)["training"];
+  const nlohmann::json without = Manifest(paper)["training"];
+  for (const char* regressor : {"ordr", "obdr"}) {
+    EXPECT_EQ(with["parts"][regressor]["truth_box_positives"], true) << regressor;
+    EXPECT_EQ(without["parts"][regressor]["truth_box_positives"], false) << regressor;
+    EXPECT_GT(with["parts"][regressor]["samples"].get<int>(),
+              without["parts"][regressor]["samples"].get<int>())
+        << regressor;
+  }
+  EXPECT_EQ(with["mean_proposals_per_frame"], without["mean_proposals_per_frame"]);
+  const std::string image = (fs::path(Root()) / "images" / "1.webp").string();
+  const CommandResult detect = RunCommand(tod_ + " detect --model " + with_truth + " --out " +
+                                          (out_ / "det").string() + " " + image);
+  EXPECT_EQ(detect.exit_code, 0) << detect.output;
+}
+
 // --paste-obstacles: the regressors learn from copies of every training frame with obstacles of
 // other frames pasted in. Said in the log, recorded per regressor, more samples than the same
 // training without copies (the copies add their positives and negatives), the bundle detects,
