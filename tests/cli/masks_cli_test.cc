@@ -594,6 +594,25 @@ TEST_F(MasksCliTest, OrientationEntropyFeatureOnRequest) {
 
 }  // namespace
 
+namespace {
+
+// Two trainings' records, `with` a recipe that adds regressor rows: each regressor records `key`
+// as `with_value` / `without_value` and has more samples with it, from as many proposals a frame.
+void ExpectMoreRegressorSamples(const nlohmann::json& with, const nlohmann::json& without,
+                                const char* key, const nlohmann::json& with_value,
+                                const nlohmann::json& without_value) {
+  for (const char* regressor : {"ordr", "obdr"}) {
+    EXPECT_EQ(with["parts"][regressor][key], with_value) << regressor;
+    EXPECT_EQ(without["parts"][regressor][key], without_value) << regressor;
+    EXPECT_GT(with["parts"][regressor]["samples"].get<int>(),
+              without["parts"][regressor]["samples"].get<int>())
+        << regressor;
+  }
+  EXPECT_EQ(with["mean_proposals_per_frame"], without["mean_proposals_per_frame"]);
+}
+
+}  // namespace
+
 // Truth boxes as positives (the default): every training obstacle's own box is one more positive
 // of both regressors. Recorded per regressor; without them (--no-truth-box-positives) each
 // regressor has fewer samples, its proposals the same; the bundle detects.
@@ -606,14 +625,7 @@ TEST_F(MasksCliTest, TruthBoxesAddPositivesUnlessTurnedOff) {
   ASSERT_EQ(run_paper.exit_code, 0) << run_paper.output;
   const nlohmann::json with = Manifest(with_truth)["training"];
   const nlohmann::json without = Manifest(paper)["training"];
-  for (const char* regressor : {"ordr", "obdr"}) {
-    EXPECT_EQ(with["parts"][regressor]["truth_box_positives"], true) << regressor;
-    EXPECT_EQ(without["parts"][regressor]["truth_box_positives"], false) << regressor;
-    EXPECT_GT(with["parts"][regressor]["samples"].get<int>(),
-              without["parts"][regressor]["samples"].get<int>())
-        << regressor;
-  }
-  EXPECT_EQ(with["mean_proposals_per_frame"], without["mean_proposals_per_frame"]);
+  ExpectMoreRegressorSamples(with, without, "truth_box_positives", true, false);
   const std::string image = (fs::path(Root()) / "images" / "1.webp").string();
   const CommandResult detect = RunCommand(tod_ + " detect --model " + with_truth + " --out " +
                                           (out_ / "det").string() + " " + image);
@@ -635,15 +647,8 @@ TEST_F(MasksCliTest, PastedObstaclesAddRegressorSamples) {
   EXPECT_EQ(run_plain.output.find("cut out to paste"), std::string::npos) << run_plain.output;
   const nlohmann::json with = Manifest(pasted)["training"];
   const nlohmann::json without = Manifest(plain)["training"];
-  for (const char* regressor : {"ordr", "obdr"}) {
-    EXPECT_EQ(with["parts"][regressor]["pasted_copies"], 2) << regressor;
-    EXPECT_EQ(without["parts"][regressor]["pasted_copies"], 0) << regressor;
-    EXPECT_GT(with["parts"][regressor]["samples"].get<int>(),
-              without["parts"][regressor]["samples"].get<int>())
-        << regressor;
-  }
   // The proposals counted per frame are the real frames' only.
-  EXPECT_EQ(with["mean_proposals_per_frame"], without["mean_proposals_per_frame"]);
+  ExpectMoreRegressorSamples(with, without, "pasted_copies", 2, 0);
   const std::string image = (fs::path(Root()) / "images" / "1.webp").string();
   const CommandResult detect = RunCommand(tod_ + " detect --model " + pasted + " --out " +
                                           (out_ / "det").string() + " " + image);

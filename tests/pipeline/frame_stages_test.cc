@@ -15,16 +15,6 @@
 namespace tod {
 namespace {
 
-// The tiny bundle's maps of a 512 x 256 road frame, as the detector computes them.
-struct RoadFrameMaps {
-  ModelBundle bundle = TinyBundle();
-  cv::Mat3b frame = RoadFrame(512, 256);
-  FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
-  Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
-      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
-};
-
 TEST(FrameStagesTest, ComputesEveryMapOnR1) {
   const RoadFrameMaps maps;
   const Result<OcclusionEdges>& oaocc = maps.oaocc;

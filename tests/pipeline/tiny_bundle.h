@@ -9,6 +9,8 @@
 #include <random>
 #include <vector>
 
+#include "core/pipeline/frame_geometry.h"
+#include "core/pipeline/frame_stages.h"
 #include "core/pipeline/obstacle_detector.h"
 #include "tests/forest/fitted_forest.h"
 
@@ -60,6 +62,16 @@ inline cv::Mat3b RoadFrame(int width, int height) {
   block(0.66, 0.80, 0.06, 0.10, cv::Scalar(230, 230, 230));  // near
   return frame;
 }
+
+// The tiny bundle's maps of a 512 x 256 road frame, as the detector computes them.
+struct RoadFrameMaps {
+  ModelBundle bundle = TinyBundle();
+  cv::Mat3b frame = RoadFrame(512, 256);
+  FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
+  Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
+      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
+      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
+};
 
 // A suite whose tests share one ObstacleDetector on TinyBundle() (training its forests once).
 class TinyDetectorTest : public ::testing::Test {

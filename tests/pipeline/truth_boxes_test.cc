@@ -20,15 +20,6 @@ ObstacleInstance InstanceAt(const Box& box) {
   return obstacle;
 }
 
-struct RoadFrameMaps {
-  ModelBundle bundle = TinyBundle();
-  cv::Mat3b frame = RoadFrame(512, 256);
-  FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
-  Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
-      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
-};
-
 // The scan's own best boxes of every region, given as obstacles, come back with the scan's scores
 // in their region, and in every other region that holds them whole.
 TEST(TruthBoxesTest, ABoxTheScanFoundKeepsTheScansScoreInItsRegion) {
