@@ -1,5 +1,6 @@
 #include "core/pipeline/training_regressors.h"
 
+#include <algorithm>
 #include <atomic>
 #include <string>
 
@@ -45,18 +46,14 @@ struct FrameRows {
   }
 };
 
-// The rows of TruthBoxes, appended to both regressors' rows as positives of every bag, with the
-// targets the selection gives (mask IoU, or box IoU with SampleSelectionParams::box_iou_target).
-Status AppendTruthBoxes(const Sample& s, const OcclusionEdges& oaocc, const ModelBundle& bundle,
-                        const SampleSelectionParams& selection, const BoxFeatureOptions& features,
-                        FrameRows& rows) {
-  const ProposalSet truth =
-      TruthBoxes(s.instances, oaocc, bundle.regions, bundle.params.boxes,
-                 DetectorProposalOptions(bundle.params, bundle.regions.num_layers()).multistride);
+// The rows of the own boxes `truth` (features `x`, one row each), appended to both regressors'
+// rows as positives of every bag, with the targets the selection gives (mask IoU, or box IoU with
+// SampleSelectionParams::box_iou_target).
+Status AppendTruthRows(const Sample& s, const ProposalSet& truth, const cv::Mat1f& x,
+                       const SampleSelectionParams& selection, FrameRows& rows) {
   if (truth.boxes.empty()) return Status::Ok();
   auto table = MaskIoUTable::Build(s.instances);
   if (!table.ok()) return table.status();
-  const cv::Mat1f x = ComputeProposalFeatures(s.image, oaocc, bundle.regions, truth, features);
   for (const ScoredBox& b : truth.boxes) {
     const float target = static_cast<float>(selection.box_iou_target ? table->MaxBoxIoU(b.box)
                                                                      : table->MaxIoU(b.box));
@@ -68,6 +65,16 @@ Status AppendTruthBoxes(const Sample& s, const OcclusionEdges& oaocc, const Mode
   rows.ordr.push_back(x);
   rows.obdr.push_back(x);
   return Status::Ok();
+}
+
+// The rows of `measured` (features of distinct proposals) that `indices` (proposal indices) ask
+// for, in their order; row_of[i] is proposal i's row in `measured`.
+cv::Mat1f PickRows(const cv::Mat1f& measured, const std::vector<int>& indices,
+                   const std::vector<int>& row_of) {
+  cv::Mat1f out(static_cast<int>(indices.size()), measured.cols);
+  for (std::size_t j = 0; j < indices.size(); ++j)
+    measured.row(row_of[indices[j]]).copyTo(out.row(static_cast<int>(j)));
+  return out;
 }
 
 // §6 on one frame: its proposals (maps by `upstream`'s classifiers), ranked by objectness or, with
@@ -103,21 +110,37 @@ Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundl
     selected->ordr_targets.resize(p);
     selected->obdr_targets.resize(p);
   }
-  const BoxFeatureOptions features = FeatureOptionsForFrame(bundle, s.image.cols, s.image.rows);
+  // The two selections share their positives and may share negatives: every distinct proposal
+  // is measured once, beside the own boxes, on one set of R1's colour tables.
+  std::vector<int> distinct = selected->ordr_indices;
+  distinct.insert(distinct.end(), selected->obdr_indices.begin(), selected->obdr_indices.end());
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  ProposalSet measured = Subset(all, distinct);
+  const ProposalSet truth =
+      truth_boxes
+          ? TruthBoxes(
+                s.instances, oaocc, bundle.regions, bundle.params.boxes,
+                DetectorProposalOptions(bundle.params, bundle.regions.num_layers()).multistride)
+          : ProposalSet{};
+  measured.boxes.insert(measured.boxes.end(), truth.boxes.begin(), truth.boxes.end());
+  measured.layer.insert(measured.layer.end(), truth.layer.begin(), truth.layer.end());
+  const cv::Mat1f x =
+      ComputeProposalFeatures(s.image, oaocc, bundle.regions, measured,
+                              FeatureOptionsForFrame(bundle, s.image.cols, s.image.rows));
+  std::vector<int> row_of(all.boxes.size(), -1);
+  for (std::size_t r = 0; r < distinct.size(); ++r) row_of[distinct[r]] = static_cast<int>(r);
+
   FrameRows rows;
-  rows.ordr = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
-                                      Subset(all, selected->ordr_indices), features);
-  rows.obdr = ComputeProposalFeatures(s.image, oaocc, bundle.regions,
-                                      Subset(all, selected->obdr_indices), features);
+  rows.ordr = PickRows(x, selected->ordr_indices, row_of);
+  rows.obdr = PickRows(x, selected->obdr_indices, row_of);
   rows.ordr_targets = std::move(selected->ordr_targets);
   rows.obdr_targets = std::move(selected->obdr_targets);
   rows.ordr_bags = std::move(selected->ordr_bags);
   rows.obdr_bags = std::move(selected->obdr_bags);
   rows.proposals = static_cast<long long>(all.boxes.size());
-  if (truth_boxes) {
-    if (Status st = AppendTruthBoxes(s, oaocc, bundle, selection, features, rows); !st.ok())
-      return st;
-  }
+  const cv::Mat1f truth_rows = x.rowRange(static_cast<int>(distinct.size()), x.rows);
+  if (Status st = AppendTruthRows(s, truth, truth_rows, selection, rows); !st.ok()) return st;
   return rows;
 }
 
