@@ -156,22 +156,21 @@ int SparseEdgeMap::FirstRunAfter(int y, int x) const {
 }
 
 BoxEdgeStats SparseEdgeMap::Measure(const cv::Rect& box, const cv::Rect& inner) const {
-  BoxEdgeStats stats;
-  if (box.empty()) return stats;
+  if (box.empty()) return {};
   // Pixels per value id in the box and in the centre sub-box; all zero between calls (only the
   // touched ids are read and reset). touched has room for every id plus one scratch slot.
-  struct Tally {
-    int box;
-    int inner;
-  };
   thread_local std::vector<Tally> tallies;
   thread_local std::vector<int> touched;
   if (tallies.size() < values_.size()) tallies.resize(values_.size(), Tally{0, 0});
   if (touched.size() < values_.size() + 1) touched.resize(values_.size() + 1);
+  const int num_touched = TallyRuns(box, inner, tallies.data(), touched.data());
+  return StatsFromTallies(box, inner, tallies.data(), touched.data(), num_touched);
+}
+
+int SparseEdgeMap::TallyRuns(const cv::Rect& box, const cv::Rect& inner, Tally* const tally,
+                             int* const touched_ids) const {
   // Raw pointers in locals: the stores into the tallies could otherwise alias the members and
   // force reloads in the inner loop.
-  Tally* const tally = tallies.data();
-  int* const touched_ids = touched.data();
   const Run* const runs = runs_.data();
   const int* const row_start = row_start_.data();
   const int* const first_run = first_run_.data();
@@ -201,9 +200,14 @@ BoxEdgeStats SparseEdgeMap::Measure(const cv::Rect& box, const cv::Rect& inner) 
       t.inner += std::max(0, std::min(run.end, cx1) - std::max(run.begin, cx0));
     }
   }
+  return num_touched;
+}
 
-  // Features 1-7 from the touched ids. Values are distinct, so (count descending, value
-  // ascending) is a strict order and the mode does not depend on the order of the ids.
+BoxEdgeStats SparseEdgeMap::StatsFromTallies(const cv::Rect& box, const cv::Rect& inner,
+                                             Tally* const tally, const int* const touched_ids,
+                                             int num_touched) const {
+  // Values are distinct, so (count descending, value ascending) is a strict order and the mode
+  // does not depend on the order of the ids.
   const bool exact = sums_exact_;
   std::int64_t units = 0, inner_units = 0;
   int count = 0, inner_count = 0, mode_count = 0;
@@ -226,6 +230,7 @@ BoxEdgeStats SparseEdgeMap::Measure(const cv::Rect& box, const cv::Rect& inner) 
       mode_value = value;
     }
   }
+  BoxEdgeStats stats;
   stats.max_value = max_value;
   stats.mode_value = mode_value;
   stats.mode_count = mode_count;

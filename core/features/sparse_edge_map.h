@@ -61,8 +61,20 @@ class SparseEdgeMap {
   // Sets units_, quantum_ and sums_exact_: whether every box sum can be taken exactly in integer
   // units of the smallest ulp among values_ (pixels_of_id[id]: the map's pixels of value id).
   void DecideExactSums(const std::vector<std::int64_t>& pixels_of_id);
+  // Pixels of one value id in a box and in its centre sub-box (Measure's scratch).
+  struct Tally {
+    int box;
+    int inner;
+  };
+
   // First run of row y that ends after column x (x inside the map).
   int FirstRunAfter(int y, int x) const;
+  // Measure's first step: adds every run's pixels in `box` and `inner` to tally[id] and lists
+  // each id seen for the first time in touched_ids; returns how many it listed.
+  int TallyRuns(const cv::Rect& box, const cv::Rect& inner, Tally* tally, int* touched_ids) const;
+  // Measure's second step: features 1-7 from the listed ids' tallies, which it resets to zero.
+  BoxEdgeStats StatsFromTallies(const cv::Rect& box, const cv::Rect& inner, Tally* tally,
+                                const int* touched_ids, int num_touched) const;
   // The original (band-major, pixel by pixel) double sums; the fallback when !sums_exact_.
   void SequentialSums(const cv::Rect& box, const cv::Rect& inner, BoxEdgeStats& stats) const;
 
