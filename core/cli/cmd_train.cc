@@ -187,6 +187,11 @@ void AddProposalAndMapOptions(CLI::App* cmd, TrainArgs& args) {
                 args.train.params.orientation_entropy_feature,
                 "give the regressors one more proposal feature, the orientation entropy of the "
                 "box's strong gradients (--no-orientation-entropy-feature: without it)");
+  cmd->add_flag("--road-surround-feature,!--no-road-surround-feature",
+                args.train.params.road_surround_feature,
+                "give the regressors one more proposal feature, how unlike the road just in front "
+                "of the car the box's surround is (the default; --no-road-surround-feature: "
+                "without it)");
 }
 
 // The evaluation that follows training.

@@ -108,6 +108,13 @@ float CosineDistance(const int* a, const int* b, int bins) {
 
 }  // namespace
 
+cv::Rect RoadPatch(cv::Size crop) {
+  const int rows = std::max(1, crop.height / 10);
+  const int cols = std::max(1, crop.width / 2);
+  return cv::Rect((crop.width - cols) / 2, crop.height - rows, cols, rows) &
+         cv::Rect(cv::Point(0, 0), crop);
+}
+
 BoxFeatureExtractor::BoxFeatureExtractor(const cv::Mat1f& region_map, const cv::Mat3b& region_bgr,
                                          cv::Point region_origin, cv::Size image_size,
                                          const BoxFeatureOptions& options)
@@ -120,6 +127,7 @@ BoxFeatureExtractor::BoxFeatureExtractor(const cv::Mat1f& region_map, const cv::
   if (!status_.ok()) return;
   colour_ = std::make_shared<const ColourIntegrals>(region_bgr, region_origin);
   region_in_colour_ = cv::Rect(cv::Point(0, 0), region_map.size());
+  if (options_.road_surround) road_hist_ = colour_->Histogram(RoadPatch(colour_->size()));
   if (options_.vertical_edges || options_.orientation_entropy)
     vertical_ = std::make_shared<const VerticalEdgeIntegrals>(
         region_bgr, region_origin,
@@ -141,6 +149,7 @@ BoxFeatureExtractor::BoxFeatureExtractor(
   if (!status_.ok()) return;
   region_in_colour_ = cv::Rect(region_origin - frame_colour->origin(), region_map.size());
   colour_ = std::move(frame_colour);
+  if (options_.road_surround) road_hist_ = colour_->Histogram(RoadPatch(colour_->size()));
   if (options_.vertical_edges || options_.orientation_entropy) {
     region_in_vertical_ = region_origin - frame_vertical->origin();
     vertical_ = std::move(frame_vertical);
@@ -285,6 +294,16 @@ void BoxFeatureExtractor::AddSurroundContrast(const cv::Rect& r, BoxFeatureVecto
   f[18] = CosineDistance(box_hist.data() + kHueBins, ring_hist.data() + kHueBins, kSatValBins);
   f[19] = CosineDistance(box_hist.data() + kHueBins + kSatValBins,
                          ring_hist.data() + kHueBins + kSatValBins, kSatValBins);
+  if (options_.road_surround) {
+    const int index = kNumBoxFeatures + (options_.vertical_edges ? 1 : 0) +
+                      (options_.orientation_entropy ? 1 : 0);
+    f[index] =
+        (CosineDistance(ring_hist.data(), road_hist_.data(), kHueBins) +
+         CosineDistance(ring_hist.data() + kHueBins, road_hist_.data() + kHueBins, kSatValBins) +
+         CosineDistance(ring_hist.data() + kHueBins + kSatValBins,
+                        road_hist_.data() + kHueBins + kSatValBins, kSatValBins)) /
+        3.f;
+  }
 }
 
 cv::Mat1f BoxFeatureExtractor::ComputeAll(const std::vector<ScoredBox>& proposals) const {

@@ -44,7 +44,7 @@ namespace tod {
 // The paper's 20 features; a row has one more with each of BoxFeatureOptions::vertical_edges and
 // orientation_entropy.
 inline constexpr int kNumBoxFeatures = 20;
-inline constexpr int kMaxBoxFeatures = kNumBoxFeatures + 2;
+inline constexpr int kMaxBoxFeatures = kNumBoxFeatures + 3;
 // Compute()'s result: the row's NumBoxFeatures(options) entries, the rest 0.
 using BoxFeatureVector = std::array<float, kMaxBoxFeatures>;
 
@@ -69,12 +69,22 @@ struct BoxFeatureOptions {
   // One more feature after those (index 21, or 20 without vertical_edges): the orientation
   // entropy of the box's strong gradients (vertical_edges.h, the same tables).
   bool orientation_entropy = false;
+  // One more feature after those (ours): how unlike the road the box's surround is, the mean
+  // over H, S and V of the cosine distance between the histograms of the surround ring of
+  // features 18-20 and of the road just in front of the car (RoadPatch). Off: not computed.
+  bool road_surround = false;
 };
+
+// The road just in front of the car in a colour crop of `crop` pixels whose crop is R1 (or
+// holds it): the middle half of its columns in its bottom tenth of rows. Fixed by the regions,
+// which are fitted to the training obstacles' rows, not by any frame's content.
+cv::Rect RoadPatch(cv::Size crop);
 
 // Columns of a feature row under `options`: 20, plus one for each of vertical_edges and
 // orientation_entropy.
 inline int NumBoxFeatures(const BoxFeatureOptions& options) {
-  return kNumBoxFeatures + (options.vertical_edges ? 1 : 0) + (options.orientation_entropy ? 1 : 0);
+  return kNumBoxFeatures + (options.vertical_edges ? 1 : 0) +
+         (options.orientation_entropy ? 1 : 0) + (options.road_surround ? 1 : 0);
 }
 
 class BoxFeatureExtractor {
@@ -136,7 +146,7 @@ class BoxFeatureExtractor {
   void AddPlaceFeatures(const cv::Rect& r, BoxFeatureVector& f) const;     // 8, 9, 11-14
   void AddColourSpread(const cv::Rect& r, BoxFeatureVector& f) const;      // 15-17
   void AddEdgeOrientation(const cv::Rect& r, BoxFeatureVector& f) const;   // 21 (and 22)
-  void AddSurroundContrast(const cv::Rect& r, BoxFeatureVector& f) const;  // 18-20
+  void AddSurroundContrast(const cv::Rect& r, BoxFeatureVector& f) const;  // 18-20 (and road)
 
   Status status_;
   BoxFeatureOptions options_;
@@ -145,7 +155,8 @@ class BoxFeatureExtractor {
   cv::Size image_size_;
   SparseEdgeMap edges_;
   std::shared_ptr<const ColourIntegrals> colour_;
-  cv::Rect region_in_colour_;  // the region in colour_'s crop coordinates
+  cv::Rect region_in_colour_;    // the region in colour_'s crop coordinates
+  ColourHistogram road_hist_{};  // RoadPatch of colour_'s crop, with options_.road_surround
   // null unless options_.vertical_edges or orientation_entropy
   std::shared_ptr<const VerticalEdgeIntegrals> vertical_;
   cv::Point region_in_vertical_;  // the region's corner in vertical_'s crop

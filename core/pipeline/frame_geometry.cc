@@ -61,6 +61,7 @@ BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, i
   BoxFeatureOptions options;
   options.vertical_edges = bundle.params.vertical_edge_feature;
   options.orientation_entropy = bundle.params.orientation_entropy_feature;
+  options.road_surround = bundle.params.road_surround_feature;
   const GroundPlaneFeatureParams& params = bundle.params.box_features;
   if (params.ground_plane_size)
     options.horizon_y = MappedRow(bundle, width, height, params.horizon_y);

@@ -220,11 +220,9 @@ Status LoadRegressors(const BundleFiles& files, ModelBundle& bundle) {
   if (bundle.ordr.num_features() == features && bundle.obdr.num_features() == features)
     return Status::Ok();
   return Status::DataLoss((files.root / kOrdrFile).string() + ": regressors must take " +
-                          std::to_string(features) + " features (params.vertical_edge_feature " +
-                          (bundle.params.vertical_edge_feature ? "true" : "false") +
-                          ", params.orientation_entropy_feature " +
-                          (bundle.params.orientation_entropy_feature ? "true" : "false") +
-                          "), not " + std::to_string(bundle.ordr.num_features()) + " / " +
+                          std::to_string(features) + " features (" +
+                          ProposalFeatureSet(bundle.params) + "), not " +
+                          std::to_string(bundle.ordr.num_features()) + " / " +
                           std::to_string(bundle.obdr.num_features()));
 }
 

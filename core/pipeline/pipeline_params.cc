@@ -38,7 +38,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradien
                                                 region_merge_iou, prior_correction, edge_screening,
                                                 occlusion_screening, obstacle_calibration, fusion,
                                                 probability_map, box_features, occlusion_features,
-                                                vertical_edge_feature, orientation_entropy_feature)
+                                                vertical_edge_feature, orientation_entropy_feature,
+                                                road_surround_feature)
 
 nlohmann::json ToJson(const PipelineParams& params) { return params; }
 
@@ -95,6 +96,7 @@ int ProposalFeatureCount(const PipelineParams& params) {
   BoxFeatureOptions options;
   options.vertical_edges = params.vertical_edge_feature;
   options.orientation_entropy = params.orientation_entropy_feature;
+  options.road_surround = params.road_surround_feature;
   return NumBoxFeatures(options);
 }
 
@@ -102,6 +104,7 @@ std::string ProposalFeatureSet(const PipelineParams& params) {
   std::string set = "the paper's 20";
   if (params.vertical_edge_feature) set += ", the vertical edge share";
   if (params.orientation_entropy_feature) set += ", the orientation entropy";
+  if (params.road_surround_feature) set += ", the surround unlike the road";
   return set;
 }
 
@@ -110,6 +113,7 @@ PipelineParams TrainingDefaultParams() {
   params.occlusion_screening = {.trees = 25, .final_at_most = 0.05f};
   params.probability_map.superpixel_shares = true;
   params.vertical_edge_feature = true;
+  params.road_surround_feature = true;
   params.boxes.max_wide_aspect_ratio = 10.f;
   return params;
 }

@@ -97,10 +97,15 @@ struct PipelineParams {
   // frames", point 21). false, the default, so a bundle whose manifest predates it keeps its
   // regressors' rows.
   bool orientation_entropy_feature = false;
+  // One more proposal feature after those: how unlike the road just in front of the car a box's
+  // surround is (ours; box_features.h, README "Real frames", point 28). false, the default, so
+  // a bundle whose manifest predates it keeps its regressors' rows; `tod train` turns it on
+  // (TrainingDefaultParams).
+  bool road_surround_feature = false;
 };
 
-// The proposal features the regressors of a bundle with these parameters read: how many (20, 21
-// or 22; box_features.h's NumBoxFeatures) and which, in words.
+// The proposal features the regressors of a bundle with these parameters read: how many (20 to
+// 23; box_features.h's NumBoxFeatures) and which, in words.
 int ProposalFeatureCount(const PipelineParams& params);
 std::string ProposalFeatureSet(const PipelineParams& params);
 

@@ -227,8 +227,11 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
   EXPECT_EQ(j["map_superpixel_shares"], manifest["params"]["probability_map"]["superpixel_shares"]);
   EXPECT_NE(run.output.find("paper's map: "), std::string::npos) << run.output;
   // And which features the regressors read.
-  EXPECT_EQ(j["proposal_features"],
-            manifest["params"].value("vertical_edge_feature", false) ? 21 : 20);
+  int features = 20;
+  for (const char* optional :
+       {"vertical_edge_feature", "orientation_entropy_feature", "road_surround_feature"})
+    features += manifest["params"].value(optional, false) ? 1 : 0;
+  EXPECT_EQ(j["proposal_features"], features);
   EXPECT_NE(run.output.find("regressors: " + j["proposal_features"].dump() + " proposal features"),
             std::string::npos)
       << run.output;

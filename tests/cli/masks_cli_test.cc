@@ -522,20 +522,23 @@ TEST_F(MasksCliTest, BadFrameFailsTheRunOrIsSkippedAndCounted) {
 
 namespace {
 
-// Proposal feature 21 (the vertical edge share): `tod train` adds it by default and records it,
-// --no-vertical-edge-feature keeps the paper's 20; both bundles detect, with different scores,
-// and a manifest that claims the other feature set than its forests is refused when loaded.
-TEST_F(MasksCliTest, VerticalEdgeFeatureByDefaultPaperFeaturesOnRequest) {
+// Proposal features 21 and 22 (the vertical edge share, the surround unlike the road): `tod
+// train` adds them by default and records them, --no-vertical-edge-feature
+// --no-road-surround-feature keep the paper's 20; both bundles detect, with different scores,
+// and a manifest that claims another feature set than its forests is refused when loaded.
+TEST_F(MasksCliTest, OurFeaturesByDefaultPaperFeaturesOnRequest) {
   const std::string with = (out_ / "with").string(), paper = (out_ / "paper").string();
   const CommandResult with_run = RunCommand(Train(with, "--no-map-isolation"));
   ASSERT_EQ(with_run.exit_code, 0) << with_run.output;
-  const CommandResult paper_run =
-      RunCommand(Train(paper, "--no-map-isolation --no-vertical-edge-feature"));
+  const CommandResult paper_run = RunCommand(
+      Train(paper, "--no-map-isolation --no-vertical-edge-feature --no-road-surround-feature"));
   ASSERT_EQ(paper_run.exit_code, 0) << paper_run.output;
-  EXPECT_EQ(Manifest(with)["params"]["vertical_edge_feature"], true);
-  EXPECT_EQ(Manifest(paper)["params"]["vertical_edge_feature"], false);
+  for (const char* feature : {"vertical_edge_feature", "road_surround_feature"}) {
+    EXPECT_EQ(Manifest(with)["params"][feature], true) << feature;
+    EXPECT_EQ(Manifest(paper)["params"][feature], false) << feature;
+  }
   for (const char* regressor : {"ordr", "obdr"}) {
-    EXPECT_EQ(Manifest(with)["training"]["parts"][regressor]["features"], 21) << regressor;
+    EXPECT_EQ(Manifest(with)["training"]["parts"][regressor]["features"], 22) << regressor;
     EXPECT_EQ(Manifest(paper)["training"]["parts"][regressor]["features"], 20) << regressor;
   }
   // The edge and occlusion classifiers do not see the proposals' features.
@@ -562,10 +565,16 @@ TEST_F(MasksCliTest, VerticalEdgeFeatureByDefaultPaperFeaturesOnRequest) {
       image);
   EXPECT_NE(refused.exit_code, 0);
   EXPECT_NE(refused.output.find("must take 21 features"), std::string::npos) << refused.output;
+  // And the default bundle's manifest without the road feature: its 22-feature forests too.
+  const CommandResult no_road = DetectForged(
+      with, "forged_road", [](nlohmann::json& m) { m["params"]["road_surround_feature"] = false; },
+      image);
+  EXPECT_NE(no_road.exit_code, 0);
+  EXPECT_NE(no_road.output.find("must take 21 features"), std::string::npos) << no_road.output;
 }
 
 // The orientation entropy (ours, measured and not adopted: README "Real frames", point 21) is an
-// option: `tod train --orientation-entropy-feature` records it, its forests read 22 features,
+// option: `tod train --orientation-entropy-feature` records it, its forests read 23 features,
 // `tod detect` serves with it, and the manifest without the flag is refused by name.
 TEST_F(MasksCliTest, OrientationEntropyFeatureOnRequest) {
   const std::string model = (out_ / "entropy").string();
@@ -574,8 +583,9 @@ TEST_F(MasksCliTest, OrientationEntropyFeatureOnRequest) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(Manifest(model)["params"]["orientation_entropy_feature"], true);
   EXPECT_EQ(Manifest(model)["params"]["vertical_edge_feature"], true);
+  EXPECT_EQ(Manifest(model)["params"]["road_surround_feature"], true);
   for (const char* regressor : {"ordr", "obdr"})
-    EXPECT_EQ(Manifest(model)["training"]["parts"][regressor]["features"], 22) << regressor;
+    EXPECT_EQ(Manifest(model)["training"]["parts"][regressor]["features"], 23) << regressor;
 
   const std::string image = Root() + "/images/2.png";
   const fs::path out = out_ / "detect_entropy";
@@ -589,7 +599,7 @@ TEST_F(MasksCliTest, OrientationEntropyFeatureOnRequest) {
       model, "forged_entropy",
       [](nlohmann::json& m) { m["params"]["orientation_entropy_feature"] = false; }, image);
   EXPECT_NE(refused.exit_code, 0);
-  EXPECT_NE(refused.output.find("must take 21 features"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("must take 22 features"), std::string::npos) << refused.output;
 }
 
 }  // namespace

@@ -655,3 +655,42 @@ TEST(BoxFeaturesTest, InvalidSharedInputIsAnError) {
 
 }  // namespace
 }  // namespace tod
+
+namespace tod {
+namespace {
+
+TEST(RoadSurroundTest, RoadPatchIsTheMiddleHalfOfTheBottomTenth) {
+  EXPECT_EQ(RoadPatch({2000, 470}), cv::Rect(500, 423, 1000, 47));
+  EXPECT_EQ(RoadPatch({3, 5}), cv::Rect(1, 4, 1, 1));  // at least a pixel
+}
+
+// A grey road with a green verge along its top rows: a box whose surround is road measures 0, a
+// box on the verge's edge measures its surround's distance from the road's colours; the feature
+// sits after the optional ones that are on.
+TEST(RoadSurroundTest, ASurroundOfRoadIsZeroAVergeIsNot) {
+  cv::Mat3b frame = Uniform(40, 40, {90, 90, 90});
+  frame.rowRange(0, 10).setTo(cv::Vec3b(40, 160, 40));
+  const auto colour = std::make_shared<const ColourIntegrals>(frame, cv::Point(0, 0));
+  const cv::Mat1f map(40, 40, 0.f);
+  BoxFeatureOptions options{.road_surround = true};
+  ASSERT_EQ(NumBoxFeatures(options), kNumBoxFeatures + 1);
+  const BoxFeatureExtractor extractor(colour, map, {0, 0}, frame.size(), options);
+  ASSERT_TRUE(extractor.status().ok());
+  const int index = kNumBoxFeatures;
+  EXPECT_NEAR(extractor.Compute({16, 20, 6, 6}, 0.f)[index], 0.0, kTol);
+  // Box rows 8-13, grown by 3: rows 5-16, of which 5-9 are green (48 of the ring's 108 pixels).
+  const float verge = extractor.Compute({16, 8, 6, 6}, 0.f)[index];
+  EXPECT_GT(verge, 0.1f);
+  EXPECT_LT(verge, 1.f);
+  // Off, nothing is written past the paper's features.
+  const BoxFeatureExtractor plain(colour, map, {0, 0}, frame.size(), {});
+  EXPECT_EQ(plain.Compute({16, 8, 6, 6}, 0.f)[index], 0.f);
+  // After the vertical edge share when that is on too.
+  options.vertical_edges = true;
+  const auto vertical = std::make_shared<const VerticalEdgeIntegrals>(frame, cv::Point(0, 0));
+  const BoxFeatureExtractor both(colour, map, {0, 0}, frame.size(), options, vertical);
+  EXPECT_FLOAT_EQ(both.Compute({16, 8, 6, 6}, 0.f)[index + 1], verge);
+}
+
+}  // namespace
+}  // namespace tod

@@ -36,7 +36,7 @@ TEST(PipelineParams, JsonRoundTripAndMissingKeysKeepDefaults) {
   EXPECT_FLOAT_EQ(TrainingDefaultParams().boxes.max_wide_aspect_ratio, 10.f);
 }
 
-// The regressors' row width and its words follow the two optional features, each on its own;
+// The regressors' row width and its words follow the optional features, each on its own;
 // a manifest without the newer key keeps the older bundles' 20 or 21.
 TEST(PipelineParams, ProposalFeaturesFollowTheOptionalFeatures) {
   PipelineParams p;
@@ -51,9 +51,14 @@ TEST(PipelineParams, ProposalFeaturesFollowTheOptionalFeatures) {
   p.vertical_edge_feature = false;
   EXPECT_EQ(ProposalFeatureCount(p), 21);
   EXPECT_EQ(ProposalFeatureSet(p), "the paper's 20, the orientation entropy");
+  p.road_surround_feature = true;
+  EXPECT_EQ(ProposalFeatureCount(p), 22);
+  EXPECT_EQ(ProposalFeatureSet(p),
+            "the paper's 20, the orientation entropy, the surround unlike the road");
   const auto older = PipelineParamsFromJson({{"vertical_edge_feature", true}});
   ASSERT_TRUE(older.ok());
   EXPECT_FALSE(older->orientation_entropy_feature);
+  EXPECT_FALSE(older->road_surround_feature);
   EXPECT_EQ(ProposalFeatureCount(*older), 21);
 }
 
