@@ -6,7 +6,9 @@
 //  14-16 H/S/V standard deviation, 17-19 H/S/V contrast against the surround ring;
 //  with BoxFeatureOptions::vertical_edges one more (ours): 20 the vertical edge share
 //  (vertical_edges.h); with orientation_entropy one more after those (ours): 21 (20 without
-//  vertical_edges) the orientation entropy of the box's strong gradients (vertical_edges.h).
+//  vertical_edges) the orientation entropy of the box's strong gradients (vertical_edges.h);
+//  with road_surround one more after those (ours): how unlike the road in front of the car the
+//  surround ring is (RoadPatch below).
 //
 // Cost model (1800 x 620 region): construction is one pass over the edge map (runs of one value
 // per row, sparse_edge_map.h: 12 B per run) plus, unless a frame-wide ColourIntegrals is shared,
@@ -41,8 +43,8 @@
 
 namespace tod {
 
-// The paper's 20 features; a row has one more with each of BoxFeatureOptions::vertical_edges and
-// orientation_entropy.
+// The paper's 20 features; a row has one more with each of BoxFeatureOptions::vertical_edges,
+// orientation_entropy and road_surround.
 inline constexpr int kNumBoxFeatures = 20;
 inline constexpr int kMaxBoxFeatures = kNumBoxFeatures + 3;
 // Compute()'s result: the row's NumBoxFeatures(options) entries, the rest 0.
@@ -71,7 +73,9 @@ struct BoxFeatureOptions {
   bool orientation_entropy = false;
   // One more feature after those (ours): how unlike the road the box's surround is, the mean
   // over H, S and V of the cosine distance between the histograms of the surround ring of
-  // features 18-20 and of the road just in front of the car (RoadPatch). Off: not computed.
+  // features 18-20 and of the road just in front of the car (RoadPatch of the colour crop: R1's
+  // with the shared tables, as the pipeline builds them; the region's own with per-region
+  // tables, which is the road in front only for R1). Off: not computed.
   bool road_surround = false;
 };
 
@@ -80,8 +84,8 @@ struct BoxFeatureOptions {
 // which are fitted to the training obstacles' rows, not by any frame's content.
 cv::Rect RoadPatch(cv::Size crop);
 
-// Columns of a feature row under `options`: 20, plus one for each of vertical_edges and
-// orientation_entropy.
+// Columns of a feature row under `options`: 20, plus one for each of vertical_edges,
+// orientation_entropy and road_surround.
 inline int NumBoxFeatures(const BoxFeatureOptions& options) {
   return kNumBoxFeatures + (options.vertical_edges ? 1 : 0) +
          (options.orientation_entropy ? 1 : 0) + (options.road_surround ? 1 : 0);
