@@ -106,6 +106,14 @@ float CosineDistance(const int* a, const int* b, int bins) {
   return static_cast<float>(1.0 - dot / std::sqrt(norm_a * norm_b));
 }
 
+// Cosine distances between the H, S and V parts of two histograms (hsv.h's layout).
+std::array<float, 3> HsvCosineDistances(const ColourHistogram& a, const ColourHistogram& b) {
+  return {CosineDistance(a.data(), b.data(), kHueBins),
+          CosineDistance(a.data() + kHueBins, b.data() + kHueBins, kSatValBins),
+          CosineDistance(a.data() + kHueBins + kSatValBins, b.data() + kHueBins + kSatValBins,
+                         kSatValBins)};
+}
+
 }  // namespace
 
 cv::Rect RoadPatch(cv::Size crop) {
@@ -290,19 +298,13 @@ void BoxFeatureExtractor::AddSurroundContrast(const cv::Rect& r, BoxFeatureVecto
   const ColourHistogram box_hist = colour_->Histogram(box_in_colour);
   ColourHistogram ring_hist = colour_->Histogram(grown_in_colour);
   for (int bin = 0; bin < kColourHistBins; ++bin) ring_hist[bin] -= box_hist[bin];
-  f[17] = CosineDistance(box_hist.data(), ring_hist.data(), kHueBins);
-  f[18] = CosineDistance(box_hist.data() + kHueBins, ring_hist.data() + kHueBins, kSatValBins);
-  f[19] = CosineDistance(box_hist.data() + kHueBins + kSatValBins,
-                         ring_hist.data() + kHueBins + kSatValBins, kSatValBins);
+  const std::array<float, 3> contrast = HsvCosineDistances(box_hist, ring_hist);
+  std::copy(contrast.begin(), contrast.end(), f.begin() + 17);
   if (options_.road_surround) {
     const int index = kNumBoxFeatures + (options_.vertical_edges ? 1 : 0) +
                       (options_.orientation_entropy ? 1 : 0);
-    f[index] =
-        (CosineDistance(ring_hist.data(), road_hist_.data(), kHueBins) +
-         CosineDistance(ring_hist.data() + kHueBins, road_hist_.data() + kHueBins, kSatValBins) +
-         CosineDistance(ring_hist.data() + kHueBins + kSatValBins,
-                        road_hist_.data() + kHueBins + kSatValBins, kSatValBins)) /
-        3.f;
+    const std::array<float, 3> unlike_road = HsvCosineDistances(ring_hist, road_hist_);
+    f[index] = (unlike_road[0] + unlike_road[1] + unlike_road[2]) / 3.f;
   }
 }
 
