@@ -139,37 +139,25 @@ void BoxScorer::BuildIntegralImages(Tables& t) {
 
 namespace {
 
-// Appends the runs of non-zero ids of one line to `runs`, plus the sentinel, and sets ends[k] to
-// the last position of run k of the line. The line is given by its edge pixels (positions `at`
-// ascending; ids of all other pixels are 0): id_at(i) is the id at position i.
+// Appends the runs of non-zero ids of one line to `runs`, plus the sentinel. The line is given
+// by its edge pixels (positions `at` ascending; ids of all other pixels are 0): id_at(i) is the
+// id at position i.
 template <typename Run, typename IdAt>
-void RunsOfLine(const int* at, int count, const IdAt& id_at, std::vector<Run>& runs,
-                std::vector<int>& ends) {
-  ends.clear();
+void RunsOfLine(const int* at, int count, const IdAt& id_at, std::vector<Run>& runs) {
+  const size_t first = runs.size();
   for (int k = 0; k < count; ++k) {
     const int i = at[k];
     const int id = id_at(i);
     if (id <= 0) continue;
-    // The previous pixel continues the last run when that run ends there with the same id.
-    if (!ends.empty() && ends.back() == i - 1 && runs.back().group == id) {
-      ends.back() = i;
+    // The previous pixel continues the line's last run when that run ends there with the same id.
+    if (runs.size() > first && runs.back().last == i - 1 && runs.back().group == id) {
+      runs.back().last = i;
       continue;
     }
-    runs.push_back(Run{i, id});
-    ends.push_back(i);
+    runs.push_back(Run{i, i, id});
   }
-  runs.push_back(Run{std::numeric_limits<int>::max(), 0});
-}
-
-// Sets first_run[i] (i < length) to the index of the first run of the line (runs numbered from
-// `base`, ending at `ends`) that ends at or after i: constant over [previous end + 1, end k].
-void FillFirstRun(const std::vector<int>& ends, int base, int length, int* first_run) {
-  int i = 0;
-  for (size_t k = 0; k < ends.size(); ++k) {
-    std::fill(first_run + i, first_run + ends[k] + 1, base + static_cast<int>(k));
-    i = ends[k] + 1;
-  }
-  std::fill(first_run + i, first_run + length, base + static_cast<int>(ends.size()));
+  constexpr int kBeyond = std::numeric_limits<int>::max();
+  runs.push_back(Run{kBeyond, kBeyond, 0});
 }
 
 }  // namespace
@@ -179,47 +167,38 @@ void BoxScorer::BuildRunIndexes(Tables& t) {
   const EdgePixels& edges = t.groups.edges;
   t.row_runs.clear();
   t.col_runs.clear();
-  std::vector<int> ends;
-  // Rows first: their runs, and each run's end bucketed by column (counting sort), for the
-  // column sweep below.
-  std::vector<int> row_first(static_cast<size_t>(height_));  // row r's first run at column c
-  std::vector<int> run_row, run_end;                         // per row run (not sentinels)
+  t.row_begin.assign(static_cast<size_t>(height_) + 1, 0);
+  t.col_begin.assign(static_cast<size_t>(width_) + 1, 0);
   for (int r = 0; r < height_; ++r) {
     const int begin = edges.row_begin[r];
     const int* row = ids[r];
-    row_first[r] = static_cast<int>(t.row_runs.size());
+    t.row_begin[r] = static_cast<int>(t.row_runs.size());
     RunsOfLine(
         edges.row_col.data() + begin, edges.row_begin[r + 1] - begin,
-        [row](int c) { return row[c]; }, t.row_runs, ends);
-    for (const int end : ends) {
-      run_row.push_back(r);
-      run_end.push_back(end);
-    }
+        [row](int c) { return row[c]; }, t.row_runs);
   }
-  std::vector<int> end_begin(static_cast<size_t>(width_) + 1, 0);  // rows whose run ends at c:
-  for (const int end : run_end) ++end_begin[end + 1];              // [end_begin[c], end_begin[c+1])
-  for (int c = 0; c < width_; ++c) end_begin[c + 1] += end_begin[c];
-  std::vector<int> end_row(run_row.size());
-  {
-    std::vector<int> next(end_begin.begin(), end_begin.end() - 1);
-    for (size_t k = 0; k < run_row.size(); ++k) end_row[next[run_end[k]]++] = run_row[k];
-  }
-  // Column by column: the column's own runs, then both indexes of the column. row_first holds,
-  // per row, the first run ending at or after c (it advances past the runs that end at c once
-  // column c is written): the same values as a row-by-row fill, written sequentially.
-  ReserveFresh(t.first_run, static_cast<size_t>(width_) * height_);
-  std::vector<int> col_first(static_cast<size_t>(height_));
+  t.row_begin[height_] = static_cast<int>(t.row_runs.size());
   for (int c = 0; c < width_; ++c) {
     const int begin = edges.col_begin[c];
-    const int base = static_cast<int>(t.col_runs.size());
+    t.col_begin[c] = static_cast<int>(t.col_runs.size());
     RunsOfLine(
         edges.col_row.data() + begin, edges.col_begin[c + 1] - begin,
-        [&ids, c](int r) { return ids(r, c); }, t.col_runs, ends);
-    FillFirstRun(ends, base, height_, col_first.data());
-    FirstRuns* out = Append(t.first_run, static_cast<size_t>(height_));
-    for (int r = 0; r < height_; ++r) out[r] = FirstRuns{row_first[r], col_first[r]};
-    for (int k = end_begin[c]; k < end_begin[c + 1]; ++k) ++row_first[end_row[k]];
+        [&ids, c](int r) { return ids(r, c); }, t.col_runs);
   }
+  t.col_begin[width_] = static_cast<int>(t.col_runs.size());
+}
+
+const BoxScorer::Run* BoxScorer::FirstEndingAtOrAfter(const std::vector<Run>& runs, int begin,
+                                                      int end, int at) {
+  // Up to this many runs a line is scanned: the scan's loads are consecutive, the search's
+  // branches unpredictable.
+  constexpr int kScannedRuns = 16;
+  const Run* run = runs.data() + begin;
+  if (end - begin <= kScannedRuns) {
+    while (run->last < at) ++run;  // the sentinel's last lies beyond every position
+    return run;
+  }
+  return std::partition_point(run, runs.data() + end, [at](const Run& r) { return r.last < at; });
 }
 
 double BoxScorer::RectSum(const std::vector<double>& integral, int r0, int c0, int r1,
@@ -406,16 +385,21 @@ float BoxScorer::ScoreAfterEarlyExit(const ScoreWindow& w, double v, float norm,
       if (nodes_[g].stamp != stamp_) AddWalkEntry(g, 1.f, AnchoredInside(nodes_[g], w));
     }
   };
-  const FirstRuns* const left = &t_->first_run[static_cast<size_t>(w.c0) * height_];
-  const FirstRuns* const right = &t_->first_run[static_cast<size_t>(w.c1) * height_];
+  const Tables& t = *t_;
+  const auto row_side = [&t](int r, int c0) {
+    return FirstEndingAtOrAfter(t.row_runs, t.row_begin[r], t.row_begin[r + 1], c0);
+  };
+  const auto col_side = [&t](int c, int r0) {
+    return FirstEndingAtOrAfter(t.col_runs, t.col_begin[c], t.col_begin[c + 1], r0);
+  };
   // Check after every side: half of the walks end here, often before all four are read.
-  add_boundary_runs(&t_->row_runs[left[w.r0].row], w.c1);  // top
+  add_boundary_runs(row_side(w.r0, w.c0), w.c1);  // top
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(&t_->row_runs[left[w.r1].row], w.c1);  // bottom
+  add_boundary_runs(row_side(w.r1, w.c0), w.c1);  // bottom
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(&t_->col_runs[left[w.r0].col], w.r1);  // left
+  add_boundary_runs(col_side(w.c0, w.r0), w.r1);  // left
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
-  add_boundary_runs(&t_->col_runs[right[w.r0].col], w.r1);  // right
+  add_boundary_runs(col_side(w.c1, w.r0), w.r1);  // right
   if (Hopeless(v - removed_, norm, bar)) return 0.f;
 
   while (queue_size_ > 0) {

@@ -73,17 +73,13 @@ class BoxScorer {
     int target = 0;
     float value = 0.f;
   };
-  // A run of pixels of one group along a row (column), from `start` to the next run; the runs
-  // of each row (column) end with a sentinel whose start lies beyond every pixel.
+  // A run of pixels of one group along a row (column): positions [start, last]. The runs of each
+  // row (column) are in order and end with a sentinel whose start and last lie beyond every
+  // pixel.
   struct Run {
     int start = 0;
+    int last = 0;
     int group = 0;
-  };
-  // Index into row_runs (col_runs) of the first run of row r (column c) that ends at or after
-  // column c (row r).
-  struct FirstRuns {
-    int row = 0;
-    int col = 0;
   };
 
   // Everything derived from the map once; read-only while scoring.
@@ -94,17 +90,15 @@ class BoxScorer {
     std::vector<double> edge_mag_integral;    // M where M > edge_min_mag
     std::vector<float> norm;                  // (bw + bh)^(-kappa), index bw + bh
     ContainmentBound bound;                   // skips most walks before they start
-    // Runs of one group (id > 0) along each row (column), in order: the groups touching the box
-    // side [c0, c1] of row r are those of the runs from first_run[c0 * height + r].row (the first
-    // run of row r that ends at or after c0) while their start is <= c1; those of the side
-    // [r0, r1] of column c are the runs from first_run[c * height + r0].col on.
+    // Runs of one group (id > 0) along each row (column), in order: row r's runs (and its
+    // sentinel) are row_runs[row_begin[r], row_begin[r + 1]), column c's likewise. The groups
+    // touching the box side [c0, c1] of row r are those of the runs from the first one that
+    // ends at or after c0 while their start is <= c1 (FirstEndingAtOrAfter). A search in the
+    // line replaced a dense table of that first run per pixel (8 bytes a pixel, 9 MB for R1 of
+    // a real frame, written in full by the constructor and read at a cache miss per side):
+    // the runs of real frames' sparse maps, a few per line, stay in cache (README, Speed).
     std::vector<Run> row_runs, col_runs;
-    // Both indexes in one column-major table: the grid visits the windows of a column with the
-    // top row increasing, so the lookups of consecutive walks (top and left side at (r0, c0),
-    // bottom at (r1, c0), right at (r0, c1)) move forward through three streams instead of
-    // landing on a new 4 KiB page each (as a row-major row index would), and the top and left
-    // lookups share one cache line.
-    std::vector<FirstRuns> first_run;  // at c * height + r
+    std::vector<int> row_begin, col_begin;
     // Affinity graph without the edges that can never carry a weight >= 0.05.
     std::vector<Affinity> walk_edges;
   };
@@ -124,6 +118,10 @@ class BoxScorer {
   static double RectSumOfColumns(const double* left, const double* right, int r0, int r1) {
     return right[r1 + 1] - right[r0] - left[r1 + 1] + left[r0];
   }
+  // The first run of runs[begin, end) (one line with its sentinel, runs in order) that ends at
+  // or after position `at`: the sentinel when none does. Short lines are scanned, long ones
+  // (dense maps: a checkerboard's rows hold hundreds of runs) searched by halves.
+  static const Run* FirstEndingAtOrAfter(const std::vector<Run>& runs, int begin, int end, int at);
   bool AnchoredInside(const Node& n, const ScoreWindow& w) const {
     return n.anchor_x >= w.c0 && n.anchor_x <= w.c1 && n.anchor_y >= w.r0 && n.anchor_y <= w.r1;
   }

@@ -51,5 +51,45 @@ TEST(ReferenceScoreTest, OptimisedScorerMatchesLiteralDefinition) {
   EXPECT_GT(nonzero, 20);  // the comparison covers the walk, not only early exits
 }
 
+// Rows and columns crossing more runs than the scorer scans (16): its search by halves must find
+// the same first run as a scan. A lattice of small squares crosses ~27 runs a line.
+TEST(ReferenceScoreTest, DenseLinesAgreeWithTheLiteralDefinition) {
+  cv::Mat1f map(120, 160, 0.f);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> mag(0.2f, 1.f);
+  for (int y = 2; y + 4 < map.rows; y += 6)
+    for (int x = 2; x + 4 < map.cols; x += 6)
+      cv::rectangle(map, cv::Rect(x, y, 4, 4), cv::Scalar(mag(rng)));
+  map = NormaliseToMax(map);
+  const EdgeBoxParams params;
+  const EdgeGroupParams gp{params.edge_min_mag, params.edge_merge_thr, params.cluster_min_mag,
+                           params.gamma};
+  const EdgeGroups groups = BuildEdgeGroups(map, ComputeEdgeOrientation(map), gp);
+  // How many runs of one group the longest row holds.
+  int most_runs = 0;
+  for (int r = 0; r < map.rows; ++r) {
+    int runs = 0;
+    for (int c = 0; c < map.cols; ++c) {
+      const int id = groups.ids(r, c);
+      runs += id > 0 && (c == 0 || groups.ids(r, c - 1) != id);
+    }
+    most_runs = std::max(most_runs, runs);
+  }
+  ASSERT_GT(most_runs, 16);
+  std::uniform_int_distribution<int> cx(0, 159), ry(0, 119);
+  int nonzero = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    int c0 = cx(rng), c1 = cx(rng), r0 = ry(rng), r1 = ry(rng);
+    if (c0 > c1) std::swap(c0, c1);
+    if (r0 > r1) std::swap(r0, r1);
+    const float expected = ReferenceScore(map, groups, r0, c0, r1, c1, params);
+    const float got = ScoreSingleBox(map, Box{c0, r0, c1 - c0 + 1, r1 - r0 + 1}, params);
+    EXPECT_NEAR(got, expected, 1e-5f + 1e-5f * expected)
+        << c0 << "," << r0 << "," << c1 << "," << r1;
+    nonzero += expected > 0.f;
+  }
+  EXPECT_GT(nonzero, 20);
+}
+
 }  // namespace
 }  // namespace tod
