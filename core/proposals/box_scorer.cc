@@ -301,14 +301,31 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
     if (threshold == ContainmentBound::kNever) {
       // No window of this size can pass: the bound decided them all.
     } else if (skip_groupless_windows_ &&
-               t_->bound.InteriorTops(c0, c1, box_height, kMaxListedGroups, interior_tops_)) {
+               t_->bound.InteriorTops(c0, c1, box_height, kMaxListedGroups, interior_tops_,
+                                      &contained_steps_)) {
       // Only windows that can hold a whole group: the admitted ranges intersected with those,
-      // both sorted and disjoint, so the grid rows are scanned in the same ascending order.
+      // both sorted and disjoint, so the grid rows are scanned in the same ascending order. The
+      // listed groups give each window the exact magnitude its interior holds, a tighter bound
+      // than the corner integrals: on 8 real frames it skips a sixth of the walks the corners let
+      // through (README, Speed), and the windows it skips score 0 either way.
+      std::int64_t contained = 0;
+      auto step = contained_steps_.cbegin();
+      const auto scan_contained = [&](int begin, int end) {
+        end = std::min(end, unclamped_end);
+        for (y = grid_row_from(begin); y < end; y += stride_y) {
+          for (; step != contained_steps_.cend() && step->y <= y; ++step) contained += step->delta;
+          const int inner_r0 = y + inner_offset;
+          if (t_->bound.ContainedReaches(columns, contained, inner_r0, inner_r0 + half_h,
+                                         threshold)) {
+            reached_.push_back(y);
+          }
+        }
+      };
       const auto* a = admitted_begin;
       auto g = interior_tops_.begin();
       while (a != admitted_end && g != interior_tops_.end()) {
         const int begin = std::max(a->first, g->first), end = std::min(a->second, g->second);
-        if (begin < end) scan(begin, end);
+        if (begin < end) scan_contained(begin, end);
         (a->second < g->second) ? void(++a) : void(++g);
       }
     } else {

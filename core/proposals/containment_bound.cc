@@ -14,12 +14,7 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& e
   const int width = edges.cols, height = edges.rows;
   const int n = groups.count();
   stride_ = static_cast<size_t>(height) + 1;
-  const std::vector<GroupBox> extents = GroupExtents(groups, edges);
-  group_boxes_.reserve(n);
-  for (int s = 1; s <= n; ++s)
-    if (extents[s].c1 >= 0) group_boxes_.push_back(extents[s]);
-  std::stable_sort(group_boxes_.begin(), group_boxes_.end(),
-                   [](const GroupBox& a, const GroupBox& b) { return a.c0 < b.c0; });
+  std::vector<GroupBox> extents = GroupExtents(groups, edges);
   double total_magnitude = 0.0, total_edge = 0.0;
   for (int s = 1; s <= n; ++s) total_magnitude += groups.magnitude[s];
   // Row-major, the order of a full scan of the map: the same double sum.
@@ -33,11 +28,18 @@ ContainmentBound::ContainmentBound(const EdgeGroups& groups, const EdgePixels& e
   inverse_scale_ = 1.0 / scale;
   // The exact score is a handful of double operations on values up to the totals.
   margin_ = 1e-9 * (largest + 1.0);
+  group_boxes_.reserve(n);
+  for (int s = 1; s <= n; ++s) {
+    extents[s].magnitude = static_cast<std::uint32_t>(std::ceil(groups.magnitude[s] * scale));
+    if (extents[s].c1 >= 0) group_boxes_.push_back(extents[s]);
+  }
+  std::stable_sort(group_boxes_.begin(), group_boxes_.end(),
+                   [](const GroupBox& a, const GroupBox& b) { return a.c0 < b.c0; });
   // Both integrals are built column by column (see fresh_buffer.h) as left column + running sum
   // of this column, in modular uint32 arithmetic: the ring's sums do not depend on the order of
   // the additions, so the values equal those of any other summation order (e.g. the 2-D
   // recurrence here = pixel + up + left - up_left).
-  BuildCornerIntegral(groups, extents, scale, width, height);
+  BuildCornerIntegral(groups, extents, width, height);
   BuildEdgeIntegral(edges, scale, width, height);
 }
 
@@ -63,8 +65,8 @@ std::vector<ContainmentBound::GroupBox> ContainmentBound::GroupExtents(const Edg
 }
 
 void ContainmentBound::BuildCornerIntegral(const EdgeGroups& groups,
-                                           const std::vector<GroupBox>& extents, double scale,
-                                           int width, int height) {
+                                           const std::vector<GroupBox>& extents, int width,
+                                           int height) {
   const int n = groups.count();
   // Group magnitudes at the four bounding-box corners, bucketed by integral column.
   struct CornerValue {
@@ -81,7 +83,7 @@ void ContainmentBound::BuildCornerIntegral(const EdgeGroups& groups,
   std::vector<int> next(corner_begin.begin(), corner_begin.end() - 1);
   for (int s = 1; s <= n; ++s) {
     const GroupBox& g = extents[s];
-    const auto q = static_cast<std::uint32_t>(std::ceil(groups.magnitude[s] * scale));
+    const std::uint32_t q = g.magnitude;
     const int xs[4] = {g.c0, g.c1, g.c0, g.c1};
     const int ys[4] = {g.r0, g.r0, g.r1, g.r1};
     for (int k = 0; k < 4; ++k) corners[next[xs[k] + 1]++] = {ys[k] + 1, k, q};
@@ -129,8 +131,10 @@ void ContainmentBound::BuildEdgeIntegral(const EdgePixels& edges, double scale, 
 }
 
 bool ContainmentBound::InteriorTops(int c0, int c1, int box_height, int max_groups,
-                                    std::vector<std::pair<int, int>>& tops) const {
+                                    std::vector<std::pair<int, int>>& tops,
+                                    std::vector<ContainedStep>* steps) const {
   tops.clear();
+  if (steps != nullptr) steps->clear();
   // Groups starting in the interior's columns [c0 + 1, c1 - 1].
   const auto first = std::lower_bound(group_boxes_.begin(), group_boxes_.end(), c0 + 1,
                                       [](const GroupBox& g, int column) { return g.c0 < column; });
@@ -141,7 +145,16 @@ bool ContainmentBound::InteriorTops(int c0, int c1, int box_height, int max_grou
     if (g->c1 > c1 - 1) continue;
     // Interior rows [y + 1, y + box_height - 1] hold rows [r0, r1]: y in [r1 - h + 1, r0 - 1].
     const int begin = g->r1 - box_height + 1, end = g->r0;
-    if (begin < end) tops.emplace_back(begin, end);
+    if (begin >= end) continue;
+    tops.emplace_back(begin, end);
+    if (steps != nullptr) {
+      steps->push_back({begin, g->magnitude});
+      steps->push_back({end, -static_cast<std::int64_t>(g->magnitude)});
+    }
+  }
+  if (steps != nullptr) {
+    std::sort(steps->begin(), steps->end(),
+              [](const ContainedStep& a, const ContainedStep& b) { return a.y < b.y; });
   }
   std::sort(tops.begin(), tops.end());
   size_t merged = 0;

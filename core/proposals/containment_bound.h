@@ -109,8 +109,26 @@ class ContainmentBound {
   // without such a window, and listing the few groups in the columns is cheaper than testing
   // every window. Returns false (tops unspecified) when more than max_groups groups start in
   // the interior's columns: then listing them would cost more than the scan it saves.
+  //
+  // With `steps`, also the exact fixed-point magnitude of the groups a window's strict interior
+  // holds, as steps over the window top (sorted by y): the window at top y holds the sum of the
+  // deltas of the steps at or before y. That sum is the first term of the bound without the
+  // corners' over-count (FixedBound takes the least of four sums that each count groups sticking
+  // out elsewhere), so ContainedReaches rejects more windows than Reaches, every one of which the
+  // walk would have found hopeless (README, Speed).
+  struct ContainedStep {
+    int y = 0;
+    std::int64_t delta = 0;
+  };
   bool InteriorTops(int c0, int c1, int box_height, int max_groups,
-                    std::vector<std::pair<int, int>>& tops) const;
+                    std::vector<std::pair<int, int>>& tops,
+                    std::vector<ContainedStep>* steps = nullptr) const;
+  // Reaches() for a window whose strict interior holds groups of fixed-point magnitude
+  // `contained` (summed from InteriorTops' steps).
+  bool ContainedReaches(const Columns& v, std::int64_t contained, int ir0, int ir1,
+                        std::int64_t threshold) const {
+    return contained - InnerEdges(v, ir0, ir1) >= threshold;
+  }
 
   double ToMagnitude(std::int64_t fixed) const {
     return static_cast<double>(fixed) * inverse_scale_ + margin_;
@@ -145,16 +163,18 @@ class ContainmentBound {
     return v.inner_right[ir1 + 1] - v.inner_right[ir0] - v.inner_left[ir1 + 1] + v.inner_left[ir0];
   }
 
-  // A group's bounding box (inclusive).
+  // A group's bounding box (inclusive) and its magnitude in fixed point, rounded up.
   struct GroupBox {
     int c0 = 0, c1 = 0, r0 = 0, r1 = 0;
+    std::uint32_t magnitude = 0;
   };
   // The constructor's steps. Per group id (0 unused), its bounding box; c1 < 0 for a group
   // without pixels.
   static std::vector<GroupBox> GroupExtents(const EdgeGroups& groups, const EdgePixels& edges);
-  // cells_: the groups' magnitudes (times `scale`, rounded up) summed at their four corners.
+  // cells_: the groups' fixed-point magnitudes (GroupBox::magnitude of `extents`, indexed by
+  // group id) summed at their four corners.
   void BuildCornerIntegral(const EdgeGroups& groups, const std::vector<GroupBox>& extents,
-                           double scale, int width, int height);
+                           int width, int height);
   // edges_: the edge pixels' magnitudes (times `scale`, rounded down).
   void BuildEdgeIntegral(const EdgePixels& edges, double scale, int width, int height);
 

@@ -112,6 +112,61 @@ TEST(ContainmentBoundTest, WindowsOutsideTheInteriorTopsAllScoreZero) {
   EXPECT_FALSE(bound.InteriorTops(0, map.cols - 1, 50, 0, tops) && groups.count() > 0);
 }
 
+// The steps InteriorTops lists sum, at every window top, to the magnitude of the groups lying
+// wholly in the window's strict interior (in fixed point, each group rounded up): the exact first
+// term of the containment bound, which the corner integrals only bound from above.
+TEST(ContainmentBoundTest, ContainedStepsSumTheGroupsInTheStrictInterior) {
+  const EdgeBoxParams params;
+  const cv::Mat1f map = testing::RandomContourMap(240, 160, 6, 6);
+  const EdgeGroups groups = GroupsOf(map, params);
+  ASSERT_GT(groups.count(), 5);
+  const ContainmentBound bound(groups, map, params.edge_min_mag);
+  // Each group's bounding box, from its pixels.
+  struct Extent {
+    int c0 = 1 << 30, c1 = -1, r0 = 1 << 30, r1 = -1;
+  };
+  std::vector<Extent> extent(static_cast<size_t>(groups.count()) + 1);
+  for (int r = 0; r < map.rows; ++r) {
+    for (int c = 0; c < map.cols; ++c) {
+      const int s = groups.ids(r, c);
+      if (s <= 0) continue;
+      Extent& e = extent[s];
+      e.c0 = std::min(e.c0, c), e.c1 = std::max(e.c1, c);
+      e.r0 = std::min(e.r0, r), e.r1 = std::max(e.r1, r);
+    }
+  }
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> cx(0, map.cols - 1), size(3, 150);
+  std::vector<std::pair<int, int>> tops;
+  std::vector<ContainmentBound::ContainedStep> steps;
+  int listed = 0, holding = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int c0 = cx(rng), c1 = std::min(map.cols - 1, c0 + size(rng));
+    const int h = size(rng);
+    if (!bound.InteriorTops(c0, c1, h, 32, tops, &steps)) continue;
+    ++listed;
+    for (size_t i = 1; i < steps.size(); ++i) ASSERT_LE(steps[i - 1].y, steps[i].y);
+    std::int64_t contained = 0;
+    size_t next = 0;
+    for (int y = -h; y + h < map.rows; ++y) {
+      for (; next < steps.size() && steps[next].y <= y; ++next) contained += steps[next].delta;
+      double inside =
+          0.0;  // the groups wholly in rows [y + 1, y + h - 1], columns [c0 + 1, c1 - 1]
+      for (int s = 1; s <= groups.count(); ++s) {
+        const Extent& e = extent[s];
+        if (e.c1 >= 0 && e.c0 > c0 && e.c1 < c1 && e.r0 > y && e.r1 < y + h)
+          inside += groups.magnitude[s];
+      }
+      holding += inside > 0.0;
+      // ToMagnitude adds the rounding margin; each group's rounding up adds < 2^-24 or so.
+      EXPECT_GE(bound.ToMagnitude(contained), inside) << c0 << "," << c1 << "," << y << "," << h;
+      EXPECT_LE(bound.ToMagnitude(contained), inside + 1e-4) << c0 << "," << c1 << "," << y;
+    }
+  }
+  EXPECT_GT(listed, 100);
+  EXPECT_GT(holding, 1000);  // windows that hold groups, not only empty sums
+}
+
 // The plain definition: every grid window through BoxScorer::Score, refined, then NMS.
 std::vector<ScoredBox> PlainScan(const cv::Mat1f& map, const EdgeBoxParams& params) {
   BoxScorer scorer(map, params);
