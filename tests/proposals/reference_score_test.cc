@@ -19,6 +19,31 @@ namespace {
 
 using testing::ReferenceScore;
 
+EdgeGroups GroupsOf(const cv::Mat1f& map, const EdgeBoxParams& params) {
+  const EdgeGroupParams gp{params.edge_min_mag, params.edge_merge_thr, params.cluster_min_mag,
+                           params.gamma};
+  return BuildEdgeGroups(map, ComputeEdgeOrientation(map), gp);
+}
+
+// Scores `trials` random boxes of the map with the optimised scorer and the literal definition
+// (equal up to the order of floating-point summation); returns how many score above 0.
+int CompareRandomBoxes(const cv::Mat1f& map, const EdgeGroups& groups, const EdgeBoxParams& params,
+                       std::mt19937& rng, int trials) {
+  std::uniform_int_distribution<int> cx(0, map.cols - 1), ry(0, map.rows - 1);
+  int nonzero = 0;
+  for (int trial = 0; trial < trials; ++trial) {
+    int c0 = cx(rng), c1 = cx(rng), r0 = ry(rng), r1 = ry(rng);
+    if (c0 > c1) std::swap(c0, c1);
+    if (r0 > r1) std::swap(r0, r1);
+    const float expected = ReferenceScore(map, groups, r0, c0, r1, c1, params);
+    const float got = ScoreSingleBox(map, Box{c0, r0, c1 - c0 + 1, r1 - r0 + 1}, params);
+    EXPECT_NEAR(got, expected, 1e-5f + 1e-5f * expected)
+        << c0 << "," << r0 << "," << c1 << "," << r1;
+    nonzero += expected > 0.f;
+  }
+  return nonzero;
+}
+
 TEST(ReferenceScoreTest, OptimisedScorerMatchesLiteralDefinition) {
   std::mt19937 rng(11);
   cv::Mat1f map(120, 160, 0.f);
@@ -31,23 +56,9 @@ TEST(ReferenceScoreTest, OptimisedScorerMatchesLiteralDefinition) {
   cv::line(map, {0, 60}, {159, 75}, cv::Scalar(0.9f));
   map = NormaliseToMax(map);
   const EdgeBoxParams params;
-  const EdgeGroupParams gp{params.edge_min_mag, params.edge_merge_thr, params.cluster_min_mag,
-                           params.gamma};
-  const EdgeGroups groups = BuildEdgeGroups(map, ComputeEdgeOrientation(map), gp);
+  const EdgeGroups groups = GroupsOf(map, params);
   ASSERT_GT(groups.count(), 20);
-  std::uniform_int_distribution<int> cx(0, 159), ry(0, 119);
-  int nonzero = 0;
-  for (int trial = 0; trial < 600; ++trial) {
-    int c0 = cx(rng), c1 = cx(rng), r0 = ry(rng), r1 = ry(rng);
-    if (c0 > c1) std::swap(c0, c1);
-    if (r0 > r1) std::swap(r0, r1);
-    const float expected = ReferenceScore(map, groups, r0, c0, r1, c1, params);
-    const float got = ScoreSingleBox(map, Box{c0, r0, c1 - c0 + 1, r1 - r0 + 1}, params);
-    // Equal up to the order of floating-point summation.
-    EXPECT_NEAR(got, expected, 1e-5f + 1e-5f * expected)
-        << c0 << "," << r0 << "," << c1 << "," << r1;
-    nonzero += expected > 0.f;
-  }
+  const int nonzero = CompareRandomBoxes(map, groups, params, rng, 600);
   EXPECT_GT(nonzero, 20);  // the comparison covers the walk, not only early exits
 }
 
@@ -62,9 +73,7 @@ TEST(ReferenceScoreTest, DenseLinesAgreeWithTheLiteralDefinition) {
       cv::rectangle(map, cv::Rect(x, y, 4, 4), cv::Scalar(mag(rng)));
   map = NormaliseToMax(map);
   const EdgeBoxParams params;
-  const EdgeGroupParams gp{params.edge_min_mag, params.edge_merge_thr, params.cluster_min_mag,
-                           params.gamma};
-  const EdgeGroups groups = BuildEdgeGroups(map, ComputeEdgeOrientation(map), gp);
+  const EdgeGroups groups = GroupsOf(map, params);
   // How many runs of one group the longest row holds.
   int most_runs = 0;
   for (int r = 0; r < map.rows; ++r) {
@@ -76,18 +85,7 @@ TEST(ReferenceScoreTest, DenseLinesAgreeWithTheLiteralDefinition) {
     most_runs = std::max(most_runs, runs);
   }
   ASSERT_GT(most_runs, 16);
-  std::uniform_int_distribution<int> cx(0, 159), ry(0, 119);
-  int nonzero = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    int c0 = cx(rng), c1 = cx(rng), r0 = ry(rng), r1 = ry(rng);
-    if (c0 > c1) std::swap(c0, c1);
-    if (r0 > r1) std::swap(r0, r1);
-    const float expected = ReferenceScore(map, groups, r0, c0, r1, c1, params);
-    const float got = ScoreSingleBox(map, Box{c0, r0, c1 - c0 + 1, r1 - r0 + 1}, params);
-    EXPECT_NEAR(got, expected, 1e-5f + 1e-5f * expected)
-        << c0 << "," << r0 << "," << c1 << "," << r1;
-    nonzero += expected > 0.f;
-  }
+  const int nonzero = CompareRandomBoxes(map, groups, params, rng, 300);
   EXPECT_GT(nonzero, 20);
 }
 
