@@ -229,6 +229,7 @@ Result<FrameBenchReport> RunFrameBench(const ObstacleDetector& detector,
   FrameBenchReport report;
   report.model = detector.info().name;
   report.threads = options.threads;
+  report.threads_per_request = options.detect.threads;
   report.budget_ms = options.detect.budget_ms;
   const Status bad = ApplyBadFramePolicy(
       per_frame, [&](int i) { return frames[i]; }, BadFramePolicy::kSkip, &report.skipped);

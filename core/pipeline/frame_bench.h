@@ -67,8 +67,9 @@ Spread SpreadOf(std::vector<double> values);
 
 struct FrameBenchReport {
   std::string model;
-  int threads = 1;
-  double budget_ms = 0;                   // DetectOptions::budget_ms of the run (0: none)
+  int threads = 1;              // frames measured side by side
+  int threads_per_request = 1;  // DetectOptions::threads of every frame (--threads-per-request)
+  double budget_ms = 0;         // DetectOptions::budget_ms of the run (0: none)
   std::vector<FrameBenchRecord> records;  // the frames measured, in path order
   std::vector<SkippedFrame> skipped;      // frames that could not be decoded or detected
   std::vector<std::pair<std::string, Spread>> stages_ms;  // as FrameBenchRecord::stages_ms

@@ -63,7 +63,9 @@ int DegradedFrames(const FrameBenchReport& report) {
 std::string FormatBenchReport(const FrameBenchReport& report) {
   std::ostringstream out;
   out << report.records.size() << " frames, model " << report.model << ", " << report.threads
-      << (report.threads == 1 ? " thread" : " threads") << " (one frame per thread)";
+      << (report.threads == 1 ? " thread" : " threads") << " (one frame per thread), "
+      << report.threads_per_request << (report.threads_per_request == 1 ? " thread" : " threads")
+      << " per request";
   if (!report.skipped.empty()) out << ", " << report.skipped.size() << " skipped";
   if (report.budget_ms > 0) {
     out << ", frame budget " << Fixed(report.budget_ms, 0) << " ms (" << DegradedFrames(report)
@@ -96,6 +98,7 @@ nlohmann::json BenchReportToJson(const FrameBenchReport& report) {
   j["frames"] = report.records.size();
   j["model"] = report.model;
   j["threads"] = report.threads;
+  j["threads_per_request"] = report.threads_per_request;
   j["frame_budget_ms"] = report.budget_ms;
   j["degraded_frames"] = DegradedFrames(report);
   nlohmann::json stages = nlohmann::json::object();

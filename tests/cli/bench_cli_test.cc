@@ -70,6 +70,8 @@ TEST_F(BenchCliTest, TwoFramesGiveTheContractJsonAndTables) {
   std::ifstream in(json_path);
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["frames"], 2);
+  EXPECT_EQ(j["threads_per_request"], 1);
+  EXPECT_NE(run.output.find("1 thread per request"), std::string::npos) << run.output;
   ASSERT_TRUE(j["stages_ms"].is_object());
   for (const std::string& stage : kStages) {
     ASSERT_TRUE(j["stages_ms"].contains(stage)) << stage;
@@ -126,6 +128,8 @@ TEST_F(BenchCliTest, FrameBudgetDegradationIsReportedByBenchAndDetect) {
   std::ifstream in(json_path);
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["frame_budget_ms"], 1);
+  EXPECT_EQ(j["threads_per_request"], 2);
+  EXPECT_NE(run.output.find("2 threads per request"), std::string::npos) << run.output;
   EXPECT_EQ(j["degraded_frames"], 2);
   for (const nlohmann::json& frame : j["per_frame"])
     EXPECT_EQ(frame["degraded_stages"], nlohmann::json({"occlusion", "proposals"})) << frame.dump();
