@@ -207,7 +207,6 @@ Result<FrameBenchReport> RunFrameBench(const ObstacleDetector& detector,
   if (options.warm_up) (void)MeasureFrame(detector, frames.front(), detect);
 
   const int n = static_cast<int>(frames.size());
-  std::vector<char> was_measured(frames.size(), 0);
   std::mutex progress_mutex;
   int done = 0;
   const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
@@ -216,7 +215,6 @@ Result<FrameBenchReport> RunFrameBench(const ObstacleDetector& detector,
     // Copy-assigned, not moved: the slot's path and stage list keep their storage (the same path,
     // at most kStageSlots stages with names short enough to live inside std::string).
     measured[i] = *record;
-    was_measured[i] = 1;
     if (options.progress) {
       std::lock_guard lock(progress_mutex);
       const double total = measured[i].stages_ms.back().second;
@@ -236,7 +234,7 @@ Result<FrameBenchReport> RunFrameBench(const ObstacleDetector& detector,
   if (!bad.ok()) return bad;
   report.records.reserve(measured.size());
   for (int i = 0; i < n; ++i)
-    if (was_measured[i]) report.records.push_back(std::move(measured[i]));
+    if (per_frame[i].ok()) report.records.push_back(std::move(measured[i]));
   if (report.records.empty())
     return Status::InvalidArgument(
         "no frame could be measured (first: " + report.skipped.front().frame + ": " +

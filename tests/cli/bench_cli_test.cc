@@ -115,6 +115,26 @@ TEST_F(BenchCliTest, LimitTakesTheFirstFramesByPath) {
   EXPECT_EQ(fs::path(j["per_frame"][0]["frame"].get<std::string>()).filename(), "a.png");
 }
 
+// A file that is named like a frame but cannot be decoded is skipped and listed; the frames
+// around it keep their own records (each frame's record has its slot from the start), in path
+// order, with one frame per thread as with one thread.
+TEST_F(BenchCliTest, AnUndecodableFrameIsSkippedAndTheOthersKeepTheirRecords) {
+  std::ofstream(frames_ / "b_broken.png") << "not a PNG";
+  const fs::path json_path = out_ / "skip.json";
+  const CommandResult run = Bench("--threads 2 --json " + json_path.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("skipped " + (frames_ / "b_broken.png").string()), std::string::npos)
+      << run.output;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["frames"], 2);
+  EXPECT_EQ(j["skipped_frames"]["count"], 1);
+  ASSERT_EQ(j["per_frame"].size(), 2u);
+  EXPECT_EQ(fs::path(j["per_frame"][0]["frame"].get<std::string>()).filename(), "a.png");
+  EXPECT_EQ(fs::path(j["per_frame"][1]["frame"].get<std::string>()).filename(), "b.png");
+  for (const nlohmann::json& frame : j["per_frame"]) EXPECT_GT(frame["stages_ms"]["total"], 0);
+}
+
 // --frame-budget-ms and --threads-per-request, as tod_server has them: a budget no frame can
 // meet degrades every frame's occlusion map (its forest stops after the first piece of trees)
 // and proposals, and bench and detect both say so.
