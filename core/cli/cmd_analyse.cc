@@ -4,7 +4,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
-#include "core/pipeline/loss_analysis.h"
+#include "core/evaluation/loss_analysis.h"
 #include "core/pipeline/model_bundle.h"
 
 namespace tod::cli {

@@ -7,7 +7,7 @@
 #include "core/base/heap_tuning.h"
 #include "core/cli/commands.h"
 #include "core/cli/request_options.h"
-#include "core/pipeline/frame_bench.h"
+#include "core/evaluation/frame_bench.h"
 #include "core/pipeline/model_bundle.h"
 #include "core/pipeline/obstacle_detector.h"
 

@@ -12,10 +12,10 @@
 #include "core/cli/commands.h"
 #include "core/cli/request_options.h"
 #include "core/data/image_file.h"
+#include "core/evaluation/stage_images.h"
 #include "core/pipeline/detection_output.h"
 #include "core/pipeline/frame_budget.h"
 #include "core/pipeline/model_bundle.h"
-#include "core/pipeline/stage_images.h"
 #include "core/pipeline/warm_up.h"
 
 namespace tod::cli {

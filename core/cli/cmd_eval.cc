@@ -3,9 +3,9 @@
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
-#include "core/pipeline/evaluator.h"
+#include "core/evaluation/evaluator.h"
+#include "core/evaluation/plots.h"
 #include "core/pipeline/model_bundle.h"
-#include "core/pipeline/plots.h"
 
 namespace tod::cli {
 

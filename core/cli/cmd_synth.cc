@@ -2,7 +2,7 @@
 #include <iostream>
 
 #include "core/cli/commands.h"
-#include "core/data/synth.h"
+#include "core/synth/synth.h"
 
 namespace tod::cli {
 

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "core/cli/commands.h"
-#include "core/pipeline/evaluator.h"
+#include "core/evaluation/evaluator.h"
 #include "core/pipeline/model_bundle.h"
-#include "core/pipeline/trainer.h"
+#include "core/training/trainer.h"
 
 namespace tod::cli {
 namespace {

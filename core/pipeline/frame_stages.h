@@ -13,7 +13,6 @@
 #include "core/pipeline/frame_budget.h"
 #include "core/pipeline/multilayer_regions.h"
 #include "core/pipeline/pipeline_params.h"
-#include "core/pipeline/proposal_features.h"
 #include "core/proposals/edge_box_scorer.h"
 #include "core/proposals/size_filter.h"
 #include "core/proposals/window_admission.h"

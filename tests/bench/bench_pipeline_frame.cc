@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "core/base/heap_tuning.h"
-#include "core/data/synth.h"
 #include "core/pipeline/detector.h"
+#include "core/synth/synth.h"
 #include "tests/bench/bench_clock.h"
 
 using tod::bench::ThreadCpuMs;

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "core/data/synth.h"
 #include "core/pipeline/model_bundle.h"
 #include "core/pipeline/obstacle_detector.h"
 #include "core/proposals/window_admission.h"
+#include "core/synth/synth.h"
 
 namespace {
 

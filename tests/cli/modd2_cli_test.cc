@@ -10,7 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/modd2/modd2_synth.h"
+#include "core/synth/modd2_synth.h"
 #include "tests/run_command.h"
 #include "tests/test_env.h"
 

@@ -1,0 +1,331 @@
+#include "core/evaluation/evaluator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <sstream>
+
+#include "core/datasets/dataset_factory.h"
+#include "core/evaluation/frame_evaluation.h"
+#include "core/metrics/instance_recall.h"
+#include "core/pipeline/obstacle_detector.h"
+#include "core/pipeline/parallel.h"
+
+namespace tod {
+namespace {
+
+const std::vector<int> kTableN = {200, 400, 600, 800, 1000};
+
+VariantCurves Curves(const RecallAccumulator& acc) {
+  VariantCurves c;
+  for (int n = 0; n <= kEvalMaxProposals; n += 5) {
+    c.n_grid.push_back(n);
+    c.recall_at_07.push_back(acc.Recall(n, 0.7));
+    c.average_recall.push_back(acc.AverageRecall(n));
+  }
+  for (double tau : RecallIouThresholds()) {
+    c.iou_grid.push_back(tau);
+    c.recall_at_1000.push_back(acc.Recall(kEvalMaxProposals, tau));
+  }
+  for (int n : kTableN) c.ar_table[n] = acc.AverageRecall(n);
+  return c;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+std::string Fixed(double v, int digits = 3) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+// An undefined metric (NaN) is null in the JSON rather than a number a reader might average.
+nlohmann::json NumberOrNull(double v) {
+  if (std::isnan(v)) return nullptr;
+  return v;
+}
+
+}  // namespace
+
+namespace {
+
+// The split's running totals: recall per variant, pixel counts per map variant, the reported
+// obstacles and the stage times. The caller serialises Add().
+class EvalTotals {
+ public:
+  explicit EvalTotals(bool calibrated_map) : map_variants_(RegressionVariants()) {
+    for (const auto& v : ProposalVariants())
+      recall_.emplace(v, RecallAccumulator(kEvalMaxProposals));
+    for (const auto& v : RegressionVariants())
+      recall_.emplace(v, RecallAccumulator(kEvalMaxProposals));
+    if (calibrated_map) map_variants_.push_back(kCalibratedMapVariant);
+    for (const auto& v : map_variants_) {
+      roc_.emplace(v, PixelRocAccumulator());
+      histograms_.emplace(v, PixelHistogramAccumulator());
+    }
+  }
+
+  Status Add(const FrameEvaluation& frame, const Sample& s) {
+    // A map that does not match its frame's masks is this frame's error, not a silent gap in
+    // the pooled pixel counts. First, so that a failing frame is counted nowhere (every map has
+    // the frame's size, so the first variant decides).
+    for (const auto& [variant, map] : frame.maps) {
+      Status st = roc_.at(variant).Add(map, s.obstacle, s.road);
+      if (st.ok()) st = histograms_.at(variant).Add(map, s.obstacle, s.road);
+      if (!st.ok()) return st.WithContext(variant);
+    }
+    reported_.false_alarms += frame.false_alarms;
+    reported_.instances_found += frame.instances_found;
+    if (s.instances.empty()) {
+      ++reported_.obstacle_free_frames;
+      reported_.false_alarms_on_obstacle_free += frame.false_alarms;
+    }
+    (s.free_space == FreeSpace::kRoadLabel ? road_labelled_ : not_obstacle_) = true;
+    std::vector<Box> gt;
+    for (const auto& inst : s.instances) gt.push_back(inst.box);
+    for (const auto& [variant, boxes] : frame.ranked) recall_.at(variant).Add(boxes, gt);
+    for (const auto& [stage, ms] : frame.stage_times) {
+      if (!stage_ms_.count(stage)) stage_order_.push_back(stage);
+      stage_ms_[stage].push_back(ms);
+    }
+    stage_ms_["total"].push_back(frame.total_ms);
+    return Status::Ok();
+  }
+
+  void Fill(EvalReport& report) const {
+    report.instances = recall_.at("EB").instances();
+    report.reported = reported_;
+    report.free_space = road_labelled_ && not_obstacle_
+                            ? "mixed: the road label where the frame has one, else every non-void "
+                              "non-obstacle pixel"
+                        : not_obstacle_
+                            ? "every non-void pixel that is not an obstacle (no road label)"
+                            : "the road label (free space)";
+    for (const auto& v : ProposalVariants()) report.proposals[v] = Curves(recall_.at(v));
+    for (const auto& v : RegressionVariants()) report.regression[v] = Curves(recall_.at(v));
+    for (const auto& v : map_variants_) {
+      report.roc[v] = roc_.at(v).Curve();
+      for (double fpr : TableFprs()) report.tpr_at_fpr[v][fpr] = TprAtFpr(report.roc[v], fpr);
+      const PixelHistogramAccumulator& histograms = histograms_.at(v);
+      report.average_precision[v] = histograms.Ap();
+      report.fpr_at_tpr95[v] = histograms.FprAtTpr(0.95);
+      report.precision_recall[v] = histograms.PrCurve();
+    }
+    std::vector<std::string> stages = stage_order_;
+    stages.push_back("total");
+    for (const auto& stage : stages) {
+      const auto times = stage_ms_.find(stage);
+      report.stage_median_ms.emplace_back(stage,
+                                          times == stage_ms_.end() ? 0.0 : Median(times->second));
+    }
+  }
+
+ private:
+  std::vector<std::string> map_variants_;
+  std::map<std::string, RecallAccumulator> recall_;
+  std::map<std::string, PixelRocAccumulator> roc_;
+  std::map<std::string, PixelHistogramAccumulator> histograms_;  // AP, FPR95
+  ReportedObstacleCounts reported_;
+  bool road_labelled_ = false, not_obstacle_ = false;
+  std::vector<std::string> stage_order_;
+  std::map<std::string, std::vector<double>> stage_ms_;
+};
+
+}  // namespace
+
+Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options) {
+  auto selection = SelectFrames(
+      {options.data_root, options.split, options.format, options.split_file, options.max_frames});
+  if (!selection.ok()) return selection.status();
+  const Dataset& dataset = *selection->dataset;
+  const int n = static_cast<int>(selection->frames.size());
+  EvalTotals totals(bundle.params.obstacle_calibration.fitted);
+  std::mutex mutex;
+  int done = 0;
+  const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
+    const auto loaded = dataset.Load(selection->frames[i]);
+    if (!loaded.ok()) return loaded.status();
+    const Result<FrameEvaluation> frame = EvaluateFrame(bundle, *loaded);
+    if (!frame.ok()) return frame.status();
+    std::lock_guard lock(mutex);
+    if (Status st = totals.Add(*frame, *loaded); !st.ok()) return st;
+    ++done;
+    if (options.progress && (done % 10 == 0 || done == n))
+      options.progress("evaluated " + std::to_string(done) + "/" + std::to_string(n) + " frames");
+    return Status::Ok();
+  });
+  EvalReport report;
+  const Status bad = ApplyBadFramePolicy(
+      per_frame, [&](int i) { return dataset.name(selection->frames[i]); }, options.on_bad_frame,
+      &report.skipped);
+  if (!bad.ok()) return bad;
+  report.frames = n - static_cast<int>(report.skipped.size());
+  report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;
+  report.map_superpixel_shares = bundle.params.probability_map.superpixel_shares;
+  report.calibration_flat = bundle.params.obstacle_calibration.flat;
+  report.proposal_features = bundle.ordr.num_features();
+  report.proposal_feature_set = ProposalFeatureSet(bundle.params);
+  totals.Fill(report);
+  return report;
+}
+
+std::vector<std::string> PixelMapVariants(const EvalReport& report) {
+  std::vector<std::string> variants = RegressionVariants();
+  if (report.roc.count(kCalibratedMapVariant)) variants.push_back(kCalibratedMapVariant);
+  return variants;
+}
+
+nlohmann::json EvalReportToJson(const EvalReport& r) {
+  nlohmann::json j;
+  j["frames"] = r.frames;
+  j["instances"] = r.instances;
+  j["skipped_frames"] = SkippedFramesToJson(r.skipped);
+  const ReportedObstacleCounts& a = r.reported;
+  const auto per = [](int count, int frames) -> nlohmann::json {
+    return frames > 0 ? nlohmann::json(static_cast<double>(count) / frames) : nlohmann::json();
+  };
+  j["obstacles"] = {{"min_obstacle_score", DetectOptions{}.min_obstacle_score},
+                    {"false_alarms_per_frame", per(a.false_alarms, r.frames)},
+                    {"obstacle_free_frames", a.obstacle_free_frames},
+                    {"false_alarms_per_obstacle_free_frame",
+                     per(a.false_alarms_on_obstacle_free, a.obstacle_free_frames)},
+                    {"instances_found", per(a.instances_found, r.instances)},
+                    {"calibration_flat", r.calibration_flat}};
+  j["free_space"] = r.free_space;
+  j["map_isolation_exponent"] = r.map_isolation_exponent;
+  j["map_superpixel_shares"] = r.map_superpixel_shares;
+  j["proposal_features"] = r.proposal_features;
+  auto ar = [](const VariantCurves& c) {
+    nlohmann::json a = nlohmann::json::object();
+    for (const auto& [n, v] : c.ar_table) a[std::to_string(n)] = v;
+    return a;
+  };
+  j["proposals"] = nlohmann::json::object();
+  for (const auto& v : ProposalVariants()) j["proposals"][v] = {{"ar", ar(r.proposals.at(v))}};
+  j["regression"] = nlohmann::json::object();
+  for (const auto& v : RegressionVariants()) {
+    nlohmann::json tpr = nlohmann::json::object();
+    for (const auto& [fpr, t] : r.tpr_at_fpr.at(v)) tpr[Fixed(fpr)] = t;
+    j["regression"][v] = {{"tpr_at_fpr", tpr},
+                          {"ar", ar(r.regression.at(v))},
+                          {"ap", NumberOrNull(r.average_precision.at(v))},
+                          {"fpr_at_tpr95", NumberOrNull(r.fpr_at_tpr95.at(v))}};
+  }
+  j["calibrated_map"] = nullptr;
+  if (r.roc.count(kCalibratedMapVariant)) {
+    nlohmann::json tpr = nlohmann::json::object();
+    for (const auto& [fpr, t] : r.tpr_at_fpr.at(kCalibratedMapVariant)) tpr[Fixed(fpr)] = t;
+    j["calibrated_map"] = {
+        {"boxes", "BP+Fusion@4"},
+        {"tpr_at_fpr", tpr},
+        {"ap", NumberOrNull(r.average_precision.at(kCalibratedMapVariant))},
+        {"fpr_at_tpr95", NumberOrNull(r.fpr_at_tpr95.at(kCalibratedMapVariant))}};
+  }
+  j["timing_ms"] = nlohmann::json::object();
+  for (const auto& [stage, ms] : r.stage_median_ms) j["timing_ms"][stage] = ms;
+  return j;
+}
+
+namespace {
+
+// What was evaluated, how the maps and regressors were set, and the reported obstacles.
+void FormatEvalSummary(const EvalReport& r, std::ostringstream& o) {
+  o << "frames " << r.frames << ", obstacle instances " << r.instances << "\n";
+  o << "free space (FPR, AP negatives): " << r.free_space << "\n";
+  o << "paper's map: "
+    << (r.map_isolation_exponent > 0.f
+            ? "each box weighted by its isolation^" + Fixed(r.map_isolation_exponent, 1)
+            : std::string("no isolation weight"))
+    << (r.map_superpixel_shares ? ", each pixel by its superpixel's share of the box"
+                                : ", whole boxes")
+    << "\n";
+  o << "regressors: " << r.proposal_features << " proposal features (" << r.proposal_feature_set
+    << ")\n";
+  const ReportedObstacleCounts& a = r.reported;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "reported obstacles (score >= %.2f): %.2f false alarms per frame, %.2f per "
+                "obstacle-free frame (%d such frames), %.2f of instances found\n",
+                DetectOptions{}.min_obstacle_score,
+                r.frames ? static_cast<double>(a.false_alarms) / r.frames : 0.0,
+                a.obstacle_free_frames
+                    ? static_cast<double>(a.false_alarms_on_obstacle_free) / a.obstacle_free_frames
+                    : 0.0,
+                a.obstacle_free_frames,
+                r.instances ? static_cast<double>(a.instances_found) / r.instances : 0.0);
+  o << text;
+  if (r.calibration_flat)
+    o << "obstacle calibration is flat: on its training frames the fused scores did not rank "
+         "obstacles first, so every obstacle scores alike (retrain on more frames)\n";
+  for (const SkippedFrame& f : r.skipped)
+    o << "skipped frame " << f.frame << ": " << f.reason << "\n";
+}
+
+// One row of an average-recall table: the variant, then AR at each of kTableN.
+void FormatRecallRow(const std::string& name, const VariantCurves& c, std::ostringstream& o) {
+  char line[256];
+  std::snprintf(line, sizeof line, "%-16s", name.c_str());
+  o << line;
+  for (int n : kTableN)
+    o << " " << std::string(7 - Fixed(c.ar_table.at(n)).size(), ' ') << Fixed(c.ar_table.at(n));
+  o << "\n";
+}
+
+// TPR at the table's FPRs, then AP and FPR at 95 % TPR, per pixel map variant.
+void FormatPixelTables(const EvalReport& r, std::ostringstream& o) {
+  char line[256];
+  o << "\nPixel ROC: TPR at FPR (regression)\n";
+  std::snprintf(line, sizeof line, "%-16s", "variant");
+  o << line;
+  for (double f : TableFprs()) o << "   " << Fixed(f);
+  o << "\n";
+  for (const auto& v : PixelMapVariants(r)) {
+    std::snprintf(line, sizeof line, "%-16s", v.c_str());
+    o << line;
+    for (double f : TableFprs()) o << "   " << Fixed(r.tpr_at_fpr.at(v).at(f));
+    o << "\n";
+  }
+  o << "\nPixel AP and FPR at 95 % TPR (8-bit map, regression)\n";
+  std::snprintf(line, sizeof line, "%-16s %7s %7s\n", "variant", "AP", "FPR95");
+  o << line;
+  const auto defined = [](double v) { return std::isnan(v) ? std::string("n/a") : Fixed(v); };
+  for (const auto& v : PixelMapVariants(r)) {
+    std::snprintf(line, sizeof line, "%-16s %7s %7s\n", v.c_str(),
+                  defined(r.average_precision.at(v)).c_str(),
+                  defined(r.fpr_at_tpr95.at(v)).c_str());
+    o << line;
+  }
+  if (r.roc.count(kCalibratedMapVariant))
+    o << "(" << kCalibratedMapVariant
+      << ": the calibrated map of BP+Fusion@4's boxes, not divided by the frame's maximum)\n";
+}
+
+}  // namespace
+
+std::string FormatEvalTables(const EvalReport& r) {
+  std::ostringstream o;
+  FormatEvalSummary(r, o);
+  o << "\nAverage recall (proposals)\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%-16s %7s %7s %7s %7s %7s\n", "variant", "200", "400", "600",
+                "800", "1000");
+  o << line;
+  for (const auto& v : ProposalVariants()) FormatRecallRow(v, r.proposals.at(v), o);
+  FormatPixelTables(r, o);
+  o << "\nAverage recall (regressed, score > 0.25)\n";
+  for (const auto& v : RegressionVariants()) FormatRecallRow(v, r.regression.at(v), o);
+  o << "\nMedian time per frame (ms)\n";
+  for (const auto& [stage, ms] : r.stage_median_ms) {
+    std::snprintf(line, sizeof line, "%-16s %9.1f\n", stage.c_str(), ms);
+    o << line;
+  }
+  return o.str();
+}
+
+}  // namespace tod

@@ -1,0 +1,97 @@
+// `tod eval`: the paper's two tables on a dataset split (ALGORITHM.md §8) for the variants
+//   proposals:  EB, OLP@1, OAOCC+OLP@1, OAOCC+OLP@4, OAOCC+OLP@4+MS   (average recall)
+//   regression: OP+ORDR@4, BP+ORDR@4, BP+Fusion@4   (TPR at FPR, average recall)
+// and, for the regression variants, the anomaly-segmentation metrics (pixel AP, FPR at 95 % TPR)
+// plus the median time of each stage per frame.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/datasets/bad_frames.h"
+#include "core/evaluation/frame_evaluation.h"
+#include "core/metrics/pixel_histogram_metrics.h"
+#include "core/metrics/pixel_roc.h"
+#include "core/pipeline/model_bundle.h"
+
+namespace tod {
+
+struct EvalOptions {
+  std::string data_root;
+  std::string format = "auto";
+  std::string split = "test";
+  std::string split_file;  // masks: instead of <data_root>/split.txt
+  int max_frames = 0;      // 0 = all
+  int threads = 0;
+  BadFramePolicy on_bad_frame = BadFramePolicy::kFail;
+  std::function<void(const std::string&)> progress;
+};
+
+struct VariantCurves {
+  std::vector<int> n_grid;             // 0, 5, ..., 1000
+  std::vector<double> recall_at_07;    // recall vs N at IoU 0.7
+  std::vector<double> iou_grid;        // 0.50 ... 1.00
+  std::vector<double> recall_at_1000;  // recall vs IoU at N = 1000
+  std::vector<double> average_recall;  // AR vs N
+  std::map<int, double> ar_table;      // N = 200 ... 1000
+};
+
+// Obstacles as the detector reports them (calibrated score >= its default minimum), counted over
+// the split: a false alarm is a reported obstacle without a ground-truth obstacle pixel.
+struct ReportedObstacleCounts {
+  int false_alarms = 0;
+  int obstacle_free_frames = 0;
+  int false_alarms_on_obstacle_free = 0;
+  int instances_found = 0;  // ground-truth instances overlapped by a reported obstacle
+};
+
+struct EvalReport {
+  int frames = 0;  // evaluated (skipped ones not counted)
+  std::vector<SkippedFrame> skipped;
+  ReportedObstacleCounts reported;
+  // What the pixel metrics' negatives are: "road label" (LAF free space, MODDv2 water) or
+  // "every non-void pixel that is not an obstacle" (mask benchmarks without a road label).
+  std::string free_space;
+  // The bundle's isolation exponent of the paper's map (box_isolation.h): the regression
+  // variants' maps weigh each box by isolation^this; 0 is the paper's map as published.
+  float map_isolation_exponent = 0.f;
+  bool map_superpixel_shares = false;  // the paper's map weighs boxes by superpixel shares
+  // The obstacle calibration was held flat in training (obstacle_calibration.h): every obstacle
+  // scores the same, so the calibrated map is the superpixel shares alone and none is reported.
+  bool calibration_flat = false;
+  // The regressors' row width and which features they are (ProposalFeatureSet): the paper's 20,
+  // with the vertical edge share and the orientation entropy when the bundle has them.
+  int proposal_features = 0;
+  std::string proposal_feature_set;
+  int instances = 0;
+  std::map<std::string, VariantCurves> proposals;   // proposal variants
+  std::map<std::string, VariantCurves> regression;  // regression variants (ranked lists)
+  std::map<std::string, RocCurve> roc;              // regression variants (+ kCalibratedMapVariant)
+  std::map<std::string, std::map<double, double>> tpr_at_fpr;
+  // On the served 8-bit map (core/metrics/pixel_histogram_metrics.h), regression variants:
+  // NaN when undefined (no obstacle pixel; for FPR also no free-space pixel).
+  std::map<std::string, double> average_precision;
+  std::map<std::string, double> fpr_at_tpr95;
+  std::map<std::string, PrecisionRecallCurve> precision_recall;
+  std::vector<std::pair<std::string, double>> stage_median_ms;  // detector stages + "total"
+};
+
+Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options);
+
+// The variants with pixel metrics in `report`: RegressionVariants(), then kCalibratedMapVariant
+// when it was evaluated.
+std::vector<std::string> PixelMapVariants(const EvalReport& report);
+
+// The JSON of the issue: {"frames","instances","proposals":{V:{"ar":{...}}},
+// "regression":{V:{"tpr_at_fpr":{...},"ar":{...},"ap":x,"fpr_at_tpr95":x}},
+// "calibrated_map":{"boxes":"BP+Fusion@4","tpr_at_fpr":{...},"ap":x,"fpr_at_tpr95":x} (null
+// without a fitted calibration),
+// "timing_ms":{STAGE:x,...,"total":x}}; an undefined "ap" / "fpr_at_tpr95" is null.
+nlohmann::json EvalReportToJson(const EvalReport& report);
+// The two tables and the timing table as text.
+std::string FormatEvalTables(const EvalReport& report);
+
+}  // namespace tod

@@ -1,0 +1,98 @@
+#include "core/training/training_run.h"
+
+#include <cstdio>
+
+#include "core/base/memory_usage.h"
+#include "core/pipeline/parallel.h"
+
+namespace tod::training {
+
+Status TrainingRun::Open() {
+  std::vector<DatasetSpec> specs = {{options_.data_root, options_.split, options_.format,
+                                     options_.split_file, options_.max_frames}};
+  for (const std::string& root : options_.more_data)
+    specs.push_back({root, options_.split, "auto", "", options_.max_frames});
+  auto selection = SelectFrames(specs);
+  if (!selection.ok()) return selection.status();
+  selection_ = std::move(*selection);
+  frames_ = selection_.frames;
+  return Status::Ok();
+}
+
+void TrainingRun::Say(const std::string& line) {
+  if (!options_.progress) return;
+  std::lock_guard lock(say_mutex_);
+  char rss[48];
+  std::snprintf(rss, sizeof rss, " [peak RSS %.0f MB]", PeakRssMb());
+  options_.progress(line + rss);
+}
+
+std::vector<Status> TrainingRun::ForEachFrame(
+    const std::vector<int>& which, const std::function<Status(int, const Sample&)>& body) {
+  return ParallelFor(static_cast<int>(which.size()), options_.threads, [&](int j) -> Status {
+    auto sample = selection_.dataset->Load(frames_[which[j]]);
+    if (!sample.ok()) return sample.status();
+    return body(which[j], *sample);
+  });
+}
+
+Status TrainingRun::FirstError(const std::vector<int>& which,
+                               const std::vector<Status>& statuses) const {
+  for (std::size_t j = 0; j < statuses.size(); ++j)
+    if (!statuses[j].ok()) return statuses[j].WithContext("frame " + FrameName(which[j]));
+  return Status::Ok();
+}
+
+Result<Survey> SurveyFrames(TrainingRun& run) {
+  const int n = run.num_frames();
+  run.Say("surveying " + std::to_string(n) + " training frames from " + run.options().data_root);
+  std::vector<int> all(n);
+  for (int i = 0; i < n; ++i) all[i] = i;
+  std::vector<cv::Size> sizes(n);
+  std::vector<std::vector<ObstacleFootprint>> per_frame(n);
+  std::vector<std::vector<ObstacleCutout>> cutouts(n);
+  const bool cut_out = run.options().pasted_copies > 0;
+  const std::vector<Status> statuses = run.ForEachFrame(all, [&](int i, const Sample& s) {
+    sizes[i] = s.image.size();
+    for (const ObstacleInstance& inst : s.instances) {
+      per_frame[i].push_back({inst.box, inst.pixel_count()});
+      if (!cut_out) continue;
+      ObstacleCutout cutout = CutOutObstacle(s, inst, i, run.options().paste);
+      if (!cutout.patch.empty()) cutouts[i].push_back(std::move(cutout));
+    }
+    return Status::Ok();
+  });
+  Survey survey;
+  const Status bad = ApplyBadFramePolicy(
+      statuses, [&](int i) { return run.FrameName(i); }, run.options().on_bad_frame,
+      &survey.skipped);
+  if (!bad.ok()) return bad;
+  for (const SkippedFrame& f : survey.skipped)
+    run.Say("skipped frame " + f.frame + ": " + f.reason);
+  for (int i = 0; i < n; ++i) {
+    if (!statuses[i].ok()) continue;
+    if (survey.usable.empty()) survey.width = sizes[i].width, survey.height = sizes[i].height;
+    if (sizes[i] != cv::Size(survey.width, survey.height)) {
+      return Status::InvalidArgument(
+          "frame " + run.FrameName(i) + " is " + std::to_string(sizes[i].width) + "x" +
+          std::to_string(sizes[i].height) + ", the split's first frame " +
+          std::to_string(survey.width) + "x" + std::to_string(survey.height) +
+          ": train on frames of one camera (a bundle then maps onto any frame size)");
+    }
+    survey.usable.push_back(i);
+    for (const ObstacleFootprint& f : per_frame[i]) {
+      survey.footprints.push_back(f);
+      survey.obstacle_boxes.push_back(f.box);
+    }
+    for (ObstacleCutout& c : cutouts[i]) survey.cutouts.push_back(std::move(c));
+  }
+  if (survey.usable.empty()) return Status::InvalidArgument("no usable training frame");
+  run.Say(std::to_string(survey.footprints.size()) + " training obstacles in " +
+          std::to_string(survey.usable.size()) + " frames");
+  if (cut_out)
+    run.Say(std::to_string(survey.cutouts.size()) +
+            " of them cut out to paste (the others have void or another obstacle in their ring)");
+  return survey;
+}
+
+}  // namespace tod::training
