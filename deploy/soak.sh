@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Soak test of tod_server's REST front end (README, "Soak"):
+# Soak test of tod_server's REST front end (docs/service.md#soak):
 #   1. starts tod_server (--workers 2) on loopback;
 #   2. measures its capacity: closed-loop tod_load with valid frames, twice as many requests in
 #      flight as workers, so the workers never wait (ok responses per second);

@@ -4,7 +4,7 @@
 # Fishyscapes Lost & Found labels, Blum et al.; both for non-commercial research only, which the
 # manifest records). Real frames give by far the better real-frame model: the same recipe trained
 # on our synthetic scenes, or on synthetic scenes and real frames together, does worse on real
-# frames it has not seen (README, "Real frames"). About 3 minutes on 2 cores.
+# frames it has not seen (docs/results.md#how-the-default-got-here). About 3 minutes on 2 cores.
 #
 # Then the held-out estimate in models/default-eval.json: the same recipe trained on frames 0-34
 # and evaluated on frames 35-49 (a folder of links with a split.txt, since the shelf is read-only).

@@ -58,7 +58,7 @@ struct PixelEdgeParams {
   double negatives_per_positive = 1.0;
   int boundary_radius = 2;
   // 16 trees, not SED's 8: a pixel forest has no structured output to average over a patch, so
-  // its variance is all in the trees (README, "Real frames", point 9: 8 -> 16 trees lifted every
+  // its variance is all in the trees (docs/findings.md#edge-forest-size: 8 -> 16 trees lifted every
   // mean over both dev folds and two seeds; 32 lifted them further at 1.4x the frame time).
   ForestParams forest{.num_trees = 16, .max_features = 0, .min_leaf_size = 5, .max_depth = 20};
   EdgeChannelParams channels;      // stored in the model: Compute() uses the trained values

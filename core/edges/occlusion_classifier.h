@@ -21,10 +21,10 @@ struct OcclusionParams {
   float floor = 0.01f;  // minimum painted value on a boundary pixel
   // 400 trees (was 100, then 200): the classifier's tree-to-tree variance reaches every later
   // stage through the occlusion map. Both dev folds x two seeds, 100 -> 200 trees: TPR@FPR 0.02
-  // 0.754 -> 0.793, AP 0.176 -> 0.194 (README, "Real frames", point 10). With the ground-plane
+  // 0.754 -> 0.793, AP 0.176 -> 0.194 (docs/findings.md#occlusion-forest-size). With ground-plane
   // box features, both folds x four seeds, 200 -> 400: AR@1000 @1 / @4 / +MS 0.260 / 0.259 /
   // 0.264 -> 0.266 / 0.272 / 0.284 (the paper's order, in 5 of 8 runs instead of 1), TPR 0.802
-  // -> 0.801, AP 0.211 -> 0.209, for 40-80 ms a real frame (point 15).
+  // -> 0.801, AP 0.211 -> 0.209, for 40-80 ms a real frame (same section).
   ForestParams forest{.num_trees = 400, .max_features = 0, .min_leaf_size = 5};
   double max_void_fraction = 0.5;  // skip training pairs with a side more void than this
   // Negative pairs kept per obstacle-contour pair (a frame keeps at least 256). The prior

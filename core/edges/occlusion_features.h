@@ -37,8 +37,9 @@ enum OcclusionFeature : int {
 // How the pair features measure size. Unset horizon: kBoundaryLength, kAreaSmaller, kAreaLarger
 // and kVerticalOrder in pixels (kVerticalOrder over the crop height), as §3.4. Set: lengths over
 // d and areas over d², d = max(1, frame row of the boundary's mean − horizon_y), the same physical
-// size at every distance (as the ground-plane box features, box_features.h; README "Real
-// frames"), and on frames of another size once the horizon is mapped (frame_geometry.h).
+// size at every distance (as the ground-plane box features, box_features.h; measured, not the
+// default: docs/findings.md#occlusion-size-features), and on frames of another size once the
+// horizon is mapped (frame_geometry.h).
 struct OcclusionFeatureOptions {
   std::optional<double> horizon_y;  // frame row; may lie above the crop
   int crop_y = 0;                   // frame row of the crop's first row

@@ -4,8 +4,8 @@
 // proposals by objectness, and among the first 1000 by regressed score. Per frame: how dense the
 // edge maps are and how much work the proposal stage does, and how the fused scores of the boxes
 // on an obstacle compare with those of the boxes on none. Over the split: where the pixel AP of
-// the paper's map (BP+Fusion@4) goes (PixelApBreakdown). This is how the README's "Real frames"
-// figures were found; it runs the pipeline's own stage functions, nothing else.
+// the paper's map (BP+Fusion@4) goes (PixelApBreakdown). This is how the figures of
+// docs/findings.md#where-the-pixel-ap-goes were found; it runs the pipeline's own stage functions.
 #pragma once
 
 #include <functional>

@@ -1,4 +1,4 @@
-// Proposal feature 21 (ours; README "Real frames", point 20): the share of a box's strong
+// Proposal feature 21 (ours; docs/method.md#vertical-edge-feature): the share of a box's strong
 // intensity gradient that lies on near-vertical edges.
 //
 // Why: the boxes that outscore the obstacles on real frames are mostly lane stripes and road
@@ -19,8 +19,8 @@
 // step of 10 levels, Sobel's 3 × 3 gain being 4, and "about vertical") and were not tuned on the
 // dev frames. The camera is taken to be upright (its horizon level), as for any road camera.
 //
-// Feature 22 (ours, an option measured and not adopted as a regressor feature: README "Real
-// frames", point 21), with orientation tables: the entropy of the
+// Feature 22 (ours, an option measured and not adopted as a regressor feature:
+// docs/findings.md#orientation-entropy-feature), with orientation tables: the entropy of the
 // orientations of the box's counted pixels. Why: among each frame's 40 best boxes the false ones
 // are mostly lane stripes, road paint, kerbs and parts of larger things, whose edges run one or
 // two ways (a stripe's two sides, a kerb's line), while a lost object shows its outline, its

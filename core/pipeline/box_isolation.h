@@ -1,5 +1,5 @@
 // How isolated a box is among the frame's best boxes: a weight the probability map (§7) may give
-// each box's score. Not in the paper; measured on real frames (README, Real frames, point 18).
+// each box's score (not in the paper; docs/method.md#isolation-weighted-map).
 //
 // Why: on real frames the boxes that outscore the obstacles mostly frame *part* of something
 // larger - a stretch of lane stripe, the grille of a car, a pedestrian's legs - and the frame's

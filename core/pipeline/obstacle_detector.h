@@ -31,7 +31,7 @@ Result<cv::Mat1f> ServedProbabilityMap(const std::vector<ScoredBox>& fused_boxes
 // Whether a frame's obstacles come from a map of their own, the same boxes painted whole: for
 // the normalised map with superpixel shares. Shares tighten a map's pixels around each object,
 // but they split the boxes' area into more and smaller components, on which the obstacles'
-// calibration fits lower scores (README "Real frames", point 19): the obstacle list, and the
+// calibration fits lower scores (docs/findings.md#superpixel-shares): the obstacle list, and the
 // calibration, stay those of the whole-box map.
 bool ObstaclesFromWholeBoxMap(const PipelineParams& params, MapKind kind);
 

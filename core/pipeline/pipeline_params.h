@@ -19,7 +19,7 @@ namespace tod {
 // The edge and occlusion classifiers are trained on class-balanced samples (every obstacle
 // contour, a few negatives per positive), so their raw outputs carry the balanced prior: on a
 // real frame, where obstacle contours are a tiny share of all boundaries, nearly every texture
-// boundary scores above Edge Boxes' 0.1 (README, "Real frames"). The standard correction for
+// boundary scores above Edge Boxes' 0.1 (docs/method.md#prior-correction). The correction for
 // class-dependent sampling maps p to p·c / (p·c + 1 - p) with c = (rate at which negatives were
 // kept) / (rate at which positives were kept), measured by `tod train`; 1 = uncorrected (bundles
 // made before the correction).
@@ -28,7 +28,8 @@ struct PriorCorrection {
   double occlusion_odds = 1.0;  // c of the occlusion classifier
 };
 
-// Sizes measured on the ground plane (ours; README "Real frames", points 11 and 12). With few
+// Sizes measured on the ground plane (ours; docs/method.md#ground-plane-box-features,
+// docs/findings.md#occlusion-size-features). With few
 // training frames the learned parts see obstacles at a few distances only, and a size in pixels
 // then says "as far as the training obstacles stood": a near obstacle, larger than any they saw,
 // looks like the large patches of road and background. On a flat road image lengths are
@@ -55,7 +56,7 @@ struct PipelineParams {
   StickySuperpixelParams superpixels;
   // The paper's Edge Boxes parameters, except that refinement is narrowed to the 5000 best grid
   // local maxima per region: refining every scoring window does not fit the frame budget
-  // (README, "Speed"; `tod train --refine-all` restores the paper's refinement).
+  // (docs/method.md#local-maxima-refinement; `tod train --refine-all` restores the paper's).
   EdgeBoxParams boxes = [] {
     EdgeBoxParams p;
     p.refine_local_maxima = true;
@@ -67,14 +68,14 @@ struct PipelineParams {
   // NMS IoU across regions when their boxes are merged into one ranking (ours; the authors' code
   // merges without it, = 1). R2..RK are crops of the same occlusion map as R1, so without it the
   // inner regions add near-copies of R1's best boxes, which take the top ranks from distinct
-  // boxes: on real frames more layers then *lowered* recall (README, "Real frames").
+  // boxes: on real frames more layers then *lowered* recall (docs/method.md#cross-region-nms).
   float region_merge_iou = 0.75f;
   PriorCorrection prior_correction;
   // Early exit in the pixel edge classifier (ours, off by default; EdgeScreening): e.g. {8, 0.02}
   // lets a cell whose mean over the first 8 trees is at most 0.02 keep that mean (half the cells
   // of a real frame). Measured on the dev folds with 32 trees, it cost more quality than the
   // extra trees gave: the occlusion classifier reads the fine structure of the small edge
-  // values, which the first trees alone leave noisier (README, "Real frames", point 9).
+  // values, which the first trees alone leave noisier (docs/findings.md#edge-screening).
   // {0, 0}: every tree on every cell.
   EdgeScreening edge_screening;
   // Early exit in the occlusion classifier (ours; OcclusionPaintOptions): a superpixel pair
@@ -88,18 +89,18 @@ struct PipelineParams {
   GroundPlaneFeatureParams box_features;
   GroundPlaneFeatureParams occlusion_features;
   // Proposal feature 21, the share of a box's strong gradient on near-vertical edges (ours;
-  // vertical_edges.h, README "Real frames", point 20). false, the default and the paper's 20
+  // vertical_edges.h, docs/method.md#vertical-edge-feature). false, the default and the paper's 20
   // features, so a bundle whose manifest predates it keeps its regressors' rows; `tod train`
   // turns it on (TrainingDefaultParams).
   bool vertical_edge_feature = false;
   // One more proposal feature after those (22nd, or 21st without vertical_edge_feature): the
-  // orientation entropy of a box's strong gradients (ours; vertical_edges.h, README "Real
-  // frames", point 21). false, the default, so a bundle whose manifest predates it keeps its
-  // regressors' rows.
+  // orientation entropy of a box's strong gradients (ours; vertical_edges.h,
+  // docs/findings.md#orientation-entropy-feature). false, the default, so a bundle whose
+  // manifest predates it keeps its regressors' rows.
   bool orientation_entropy_feature = false;
   // One more proposal feature after those: how unlike the road just in front of the car a box's
-  // surround is (ours; box_features.h, README "Real frames", point 28). false, the default, so
-  // a bundle whose manifest predates it keeps its regressors' rows; `tod train` turns it on
+  // surround is (ours; box_features.h, docs/method.md#road-surround-feature). false, the default,
+  // so a bundle whose manifest predates it keeps its regressors' rows; `tod train` turns it on
   // (TrainingDefaultParams).
   bool road_surround_feature = false;
 };
@@ -116,9 +117,10 @@ std::string ProposalFeatureSet(const PipelineParams& params);
 // hundredth of a frame's strongest boundary, far below the tenth of a region's maximum that
 // the proposals take as an edge. Both dev folds x four forest seeds: every proposal and pixel
 // metric within 0.01 of the whole walk (TPR@FPR 0.02 0.801 -> 0.816), for about 40 % of the
-// occlusion stage (README, "Real frames", point 16). The bound 0.1 cost AP 0.015 and was not
-// taken. And the map weighs its boxes by superpixel shares (ProbabilityMapParams; point 19), and
-// the proposals have the vertical edge share as a 21st feature (point 20).
+// occlusion stage (docs/method.md#occlusion-early-exit). The bound 0.1 cost AP 0.015 and was not
+// taken. And the map weighs its boxes by superpixel shares (ProbabilityMapParams;
+// docs/method.md#superpixel-shares), and the proposals have the vertical edge share as a 21st
+// feature (docs/method.md#vertical-edge-feature).
 PipelineParams TrainingDefaultParams();
 
 nlohmann::json ToJson(const PipelineParams& params);

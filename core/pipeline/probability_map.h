@@ -37,7 +37,7 @@ struct ProbabilityMapParams {
   // superpixel that the box holds (superpixel_share.h), as the calibrated map weighs it, so the
   // road in a box's corners, whose superpixels run on past the box, gains little. false, the
   // default and the paper's map, paints whole boxes; `tod train` turns it on
-  // (TrainingDefaultParams; README "Real frames", point 19).
+  // (TrainingDefaultParams; docs/method.md#superpixel-shares).
   bool superpixel_shares = false;
 };
 

@@ -96,7 +96,8 @@ class BoxScorer {
     // ends at or after c0 while their start is <= c1 (FirstEndingAtOrAfter). A search in the
     // line replaced a dense table of that first run per pixel (8 bytes a pixel, 9 MB for R1 of
     // a real frame, written in full by the constructor and read at a cache miss per side):
-    // the runs of real frames' sparse maps, a few per line, stay in cache (README, Speed).
+    // the runs of real frames' sparse maps, a few per line, stay in cache
+    // (docs/findings.md#the-walks-tables).
     std::vector<Run> row_runs, col_runs;
     std::vector<int> row_begin, col_begin;
     // Affinity graph without the edges that can never carry a weight >= 0.05.

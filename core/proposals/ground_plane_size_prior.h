@@ -5,7 +5,7 @@
 // has, a band holds a handful of obstacles, and its range is whatever those few happened to be:
 // trained on fs-laf-dev 0–34 the nearest band admitted areas 28 808–28 868 px² (one obstacle),
 // and a test obstacle 1.1× wider than the widest training one in its band lost every box on a
-// camera with a narrower field of view (README, "Real frames").
+// camera with a narrower field of view (docs/method.md#size-filter).
 //
 // On a flat road seen by a level camera, an object of physical size S whose image centre is d
 // rows below the horizon has an image size of about S·d / camera height. So h / d, w / d and

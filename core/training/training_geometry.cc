@@ -23,8 +23,9 @@ class GroundPlaneFit {
   std::optional<Result<GroundPlaneSizePrior>> fitted_;
 };
 
-// The size filter of `--regions auto` bundles: the ground-plane prior (ours, README "Real
-// frames") or the authors' per-band extremes (§4.3). Recorded in parts["size_filter"].
+// The size filter of `--regions auto` bundles: the ground-plane prior (ours,
+// docs/method.md#size-filter) or the authors' per-band extremes (§4.3). Recorded in
+// parts["size_filter"].
 Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, GroundPlaneFit& ground_plane,
                         ModelBundle& bundle, nlohmann::json& parts) {
   const std::string& recipe = run.options().size_filter_recipe;

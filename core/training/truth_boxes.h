@@ -1,4 +1,4 @@
-// Training obstacles' own boxes as proposals (not in the paper; README "Real frames", point 26):
+// Training obstacles' own boxes as proposals (ours; docs/method.md#truth-box-positives):
 // the box a perfect proposal stage would give, scored as the window scan scores a window, so the
 // regressors can learn what a box that frames an obstacle exactly looks like even where the
 // proposal stage found none.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets in their own clang build directory and runs each one in turn
-# (README, "Fuzzing").
+# (docs/service.md#fuzzing).
 #   tests/fuzz/run_fuzzers.sh                 5 seconds per target (what CI runs)
 #   tests/fuzz/run_fuzzers.sh 60              60 seconds per target
 #   tests/fuzz/run_fuzzers.sh --runs 1000000 [--max-time 600]   1 M executions per target

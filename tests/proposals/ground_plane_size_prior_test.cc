@@ -88,7 +88,8 @@ TEST(GroundPlaneSizePriorTest, KeepsEveryTrainingObstacle) {
   }
 }
 
-// The point of the prior, measured as in the README: obstacles of five physical sizes, each size
+// The point of the prior, measured as in docs/findings.md#size-filter: obstacles of five sizes,
+// each size
 // at a different set of rows, left out one at a time. The filter derived from the others keeps the
 // left-out obstacle when the prior is used; the authors' per-band extremes refuse an obstacle
 // whenever its band held no training obstacle as large or as small.
