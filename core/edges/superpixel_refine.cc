@@ -432,7 +432,7 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
     // compaction after it shrinks the running sums the next sweeps read at every move from one
     // per pixel (29 MB at half resolution on a real frame) to one per superpixel. Chained behind
     // it, the second sweep read the uncompacted sums, and the pair took longer than the two
-    // sweeps one after the other (18 against 16 ms, README Speed).
+    // sweeps one after the other (18 against 16 ms, docs/findings.md#opencv-calls-on-one-thread).
     const bool mostly_singletons = 2 * sums.size() > pixels;
     const int count = mostly_singletons ? 1 : std::min(chain, iterations - iter);
     if (count > 1) {

@@ -115,7 +115,7 @@ Result<FrameBenchRecord> MeasureFrame(const ObstacleDetector& detector, const st
 // tables have just freed, where it stays: one shared heap that keeps freed blocks
 // (heap_tuning.h) could then not join those blocks again, and grew by about 12 MB a frame for
 // the rest of the run (`tod bench` over the 50 dev frames: 948 MB peak RSS against 201 MB, with
-// 131 MB live at most; README, Speed, "The bench's heap").
+// 131 MB live at most; docs/findings.md#the-benchs-heap).
 std::vector<FrameBenchRecord> RecordSlots(const std::vector<std::string>& frames) {
   std::vector<FrameBenchRecord> slots(frames.size());
   for (std::size_t i = 0; i < frames.size(); ++i) {

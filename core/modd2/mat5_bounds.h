@@ -1,5 +1,5 @@
 // A bounds check of a MAT file before libmatio reads it. libmatio (1.5.23, Debian 12) trusts the
-// sizes in the file (both found by fuzz_modd2_mat, README "Fuzzing"):
+// sizes in the file (both found by fuzz_modd2_mat, docs/service.md#found-and-fixed):
 //  - a 378-byte file whose struct claims 10^9 elements makes Mat_VarRead allocate one matvar_t per
 //    claimed field, gigabytes before it notices the data is missing;
 //  - a file without a Level-5 header is read as MAT v4, whose 20-byte header gives a name length

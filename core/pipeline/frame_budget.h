@@ -26,8 +26,9 @@ struct FrameBudgetParams {
   // not fixed points of the budget: the whole stages before them (decode, edges, superpixels)
   // take what the machine makes them take, and fixed points (proposals by 55 % of the budget,
   // regression by 85 %) cut the proposals of every real frame on a machine where the stages
-  // before them took 1000 of the 2000 ms (README, Frame budget). A real frame's occlusion
-  // stage needs about a quarter of the time left after the superpixels.
+  // before them took 1000 of the 2000 ms
+  // (docs/findings.md#frame-budget-as-shares-of-the-time-left). A real frame's occlusion stage
+  // needs about a quarter of the time left after the superpixels.
   double occlusion_share = 0.35;
   double proposals_share = 0.5;
   double regression_share = 0.75;

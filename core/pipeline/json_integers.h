@@ -1,8 +1,8 @@
 // Integer fields read from JSON (manifest.json). nlohmann's get<int>() and the
 // NLOHMANN_DEFINE_TYPE readers cast whatever number they find to the field's type: a float outside
 // its range is undefined behaviour (fuzz_manifest: a region corner of 1.11e23 read as an int,
-// README "Fuzzing"), an integer outside it wraps silently. These check a value before it is
-// converted.
+// docs/service.md#found-and-fixed), an integer outside it wraps silently. These check a value
+// before it is converted.
 #pragma once
 
 #include <nlohmann/json.hpp>

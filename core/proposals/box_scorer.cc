@@ -307,7 +307,7 @@ int BoxScorer::ScoreColumn(int x, int box_width, int box_height, int stride_y,
       // both sorted and disjoint, so the grid rows are scanned in the same ascending order. The
       // listed groups give each window the exact magnitude its interior holds, a tighter bound
       // than the corner integrals: on 8 real frames it skips a sixth of the walks the corners let
-      // through (README, Speed), and the windows it skips score 0 either way.
+      // through (docs/findings.md#the-walks-tables), and the windows it skips score 0 either way.
       std::int64_t contained = 0;
       auto step = contained_steps_.cbegin();
       const auto scan_contained = [&](int begin, int end) {

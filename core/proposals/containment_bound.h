@@ -115,7 +115,7 @@ class ContainmentBound {
   // deltas of the steps at or before y. That sum is the first term of the bound without the
   // corners' over-count (FixedBound takes the least of four sums that each count groups sticking
   // out elsewhere), so ContainedReaches rejects more windows than Reaches, every one of which the
-  // walk would have found hopeless (README, Speed).
+  // walk would have found hopeless (docs/findings.md#the-walks-tables).
   struct ContainedStep {
     int y = 0;
     std::int64_t delta = 0;

@@ -39,7 +39,7 @@ struct EdgeBoxParams {
   // shape (one stride away in x, y or both) exceeds - with dense strides neighbouring windows
   // climb to the same box, so most refinement is repeated work; refine_limit N > 0 then keeps
   // only the N best of those by grid score (0 = no limit). See bench_pipeline_proposals and the
-  // README for the measured speed / recall trade-off.
+  // docs/method.md#local-maxima-refinement for the measured speed / recall trade-off.
   bool refine_local_maxima = false;
   int refine_limit = 0;
   // Worker threads for the window grid: 1 = the calling thread only, 0 = all hardware threads.

@@ -1,6 +1,6 @@
-// Regression tests for inputs found by fuzz_modd2_mat (README, "Fuzzing"): MAT files whose arrays
-// claim far more elements than they hold, and files without a Level-5 header, whose MAT v4 header
-// libmatio trusts; libmatio would allocate what they claim before failing.
+// Regression tests for inputs found by fuzz_modd2_mat (docs/service.md#found-and-fixed): MAT files
+// whose arrays claim far more elements than they hold, and files without a Level-5 header, whose
+// MAT v4 header libmatio trusts; libmatio would allocate what they claim before failing.
 #include <gtest/gtest.h>
 
 #include <chrono>

@@ -1,5 +1,5 @@
 // Integers read from manifest.json are checked before nlohmann converts them (json_integers.h);
-// the regression input is fuzz_manifest's finding (README, "Fuzzing").
+// the regression input is fuzz_manifest's finding (docs/service.md#found-and-fixed).
 #include "core/pipeline/json_integers.h"
 
 #include <gtest/gtest.h>

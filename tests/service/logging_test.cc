@@ -1,5 +1,6 @@
 // The text log format keeps one request per line whatever the client sent (a regression input of
-// fuzz_rest_request, README "Fuzzing": a frame_id of "a%0Ab" used to split the request's log line).
+// fuzz_rest_request, docs/service.md#found-and-fixed: a frame_id of "a%0Ab" used to split the
+// request's log line).
 #include "server/logging.h"
 
 #include <gtest/gtest.h>
