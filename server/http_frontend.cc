@@ -4,6 +4,7 @@
 #include <cctype>
 #include <chrono>
 
+#include "server/access_log.h"
 #include "server/detect_response.h"
 #include "server/http/http_server.h"
 #include "server/http/query_string.h"
@@ -87,20 +88,21 @@ class RestApi {
     auto finish = [this, started, request_id, path, event, request, respond](
                       http::Response response, const std::string& code, const std::string& error,
                       const std::string& frame_id) {
-      const double ms =
+      AccessRecord access;
+      access.event = event;
+      access.protocol = "http";
+      access.id = request_id;
+      access.path = path;
+      access.frame = frame_id;
+      access.peer = request->peer;
+      access.bytes = request->message.body().size();
+      access.status = response.result_int();
+      access.code = code;
+      access.ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
               .count();
-      metrics_.RecordRequest("http", code, ms / 1000.0);
-      nlohmann::json fields = {{"id", request_id},
-                               {"protocol", "http"},
-                               {"path", path},
-                               {"frame", frame_id},
-                               {"peer", request->peer},
-                               {"bytes", request->message.body().size()},
-                               {"status", response.result_int()},
-                               {"ms", ms}};
-      if (!error.empty()) fields["error"] = error;
-      LogEvent(error.empty() ? spdlog::level::info : spdlog::level::warn, event, fields);
+      if (!error.empty()) access.error = error;
+      LogAccess(access, metrics_);
       respond(std::move(response));
     };
 
