@@ -4,6 +4,7 @@
 #include <cctype>
 #include <chrono>
 
+#include "proto/json/message_json.h"
 #include "server/access_log.h"
 #include "server/detect_response.h"
 #include "server/http/http_server.h"
@@ -75,7 +76,7 @@ class RestApi {
     tod::v1::ModelInfo info;
     FillModelInfo(*model, &info);
     metrics_.RecordRequest("http", "OK", 0);
-    return http::ContentResponse(MessageToJson(info), kJson);
+    return http::ContentResponse(proto::MessageToJson(info), kJson);
   }
 
   void Detect(http::IncomingRequest incoming, http::Responder respond, bool map_only) const {
@@ -156,7 +157,7 @@ class RestApi {
       }
       tod::v1::DetectResponse message;
       FillDetectResponse(result, frame_id, &message);
-      finish(http::ContentResponse(MessageToJson(message), kJson), code, "", frame_id);
+      finish(http::ContentResponse(proto::MessageToJson(message), kJson), code, "", frame_id);
     });
   }
 
