@@ -14,6 +14,7 @@
 #include "client/detect_outputs.h"
 #include "client/image_files.h"
 #include "client/tod_grpc_client.h"
+#include "proto/json/message_json.h"
 
 namespace {
 
@@ -47,7 +48,7 @@ bool Report(const DetectArgs& args, const std::string& path, const std::string& 
   if (args.out_dir.empty()) {
     tod::v1::DetectResponse printed = response;
     printed.mutable_probability_map()->clear_png();
-    std::cout << tod::client::ToJson(printed) << "\n";
+    std::cout << tod::proto::MessageToJson(printed, tod::proto::JsonLayout::kIndented) << "\n";
     return true;
   }
   if (const tod::Status s = tod::client::WriteDetectOutputs(args.out_dir, path, image, response);
@@ -156,7 +157,7 @@ int RunInfo(const std::string& addr, const ConnectionArgs& connection) {
               << status.error_message() << "\n";
     return 1;
   }
-  std::cout << tod::client::ToJson(info) << "\n";
+  std::cout << tod::proto::MessageToJson(info, tod::proto::JsonLayout::kIndented) << "\n";
   return 0;
 }
 

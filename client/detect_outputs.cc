@@ -1,25 +1,14 @@
 #include "client/detect_outputs.h"
 
-#include <google/protobuf/util/json_util.h>
-
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
 
 #include "client/image_files.h"
 #include "client/overlay.h"
+#include "proto/json/message_json.h"
 
 namespace tod::client {
-
-std::string ToJson(const google::protobuf::Message& message) {
-  google::protobuf::util::JsonPrintOptions options;
-  options.preserve_proto_field_names = true;
-  options.always_print_primitive_fields = true;
-  options.add_whitespace = true;
-  std::string json;
-  if (!google::protobuf::util::MessageToJsonString(message, &json, options).ok()) json = "{}";
-  return json;
-}
 
 Status WriteDetectOutputs(const std::string& out_dir, const std::string& image_path,
                           const std::string& image_bytes, const tod::v1::DetectResponse& response) {
@@ -31,7 +20,8 @@ Status WriteDetectOutputs(const std::string& out_dir, const std::string& image_p
 
   tod::v1::DetectResponse without_map = response;
   without_map.mutable_probability_map()->clear_png();
-  if (Status s = WriteFileBytes(stem + ".json", ToJson(without_map) + "\n"); !s.ok()) return s;
+  const std::string json = proto::MessageToJson(without_map, proto::JsonLayout::kIndented);
+  if (Status s = WriteFileBytes(stem + ".json", json + "\n"); !s.ok()) return s;
 
   const std::string& png = response.probability_map().png();
   cv::Mat1b probability;

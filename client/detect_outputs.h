@@ -1,8 +1,7 @@
-// What tod_client writes per image: <stem>.json (the response, map bytes left out),
-// <stem>.map.png (the probability map, when returned) and <stem>.overlay.png.
+// What tod_client writes per image: <stem>.json (the response as indented JSON, proto/json/,
+// map bytes left out), <stem>.map.png (the probability map, when returned) and
+// <stem>.overlay.png.
 #pragma once
-
-#include <google/protobuf/message.h>
 
 #include <string>
 
@@ -10,9 +9,6 @@
 #include "tod/v1/obstacle_discovery.pb.h"
 
 namespace tod::client {
-
-// Proto3 JSON with the .proto field names and default values printed.
-std::string ToJson(const google::protobuf::Message& message);
 
 // `image_bytes` is the encoded frame that was sent (for the overlay).
 Status WriteDetectOutputs(const std::string& out_dir, const std::string& image_path,

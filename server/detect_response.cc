@@ -1,7 +1,5 @@
 #include "server/detect_response.h"
 
-#include <google/protobuf/util/json_util.h>
-
 namespace tod::server {
 namespace {
 
@@ -85,16 +83,6 @@ void FillModelInfo(const LoadedModel& model, tod::v1::ModelInfo* info) {
   info->set_model_dir(bundle.name);
   info->set_generation(model.generation);
   info->set_loaded_at(model.loaded_at);
-}
-
-std::string MessageToJson(const google::protobuf::Message& message) {
-  google::protobuf::util::JsonPrintOptions options;
-  options.preserve_proto_field_names = true;
-  options.always_print_primitive_fields = true;
-  std::string json;
-  // Printing a valid message cannot fail; an empty object is the safe fallback.
-  if (!google::protobuf::util::MessageToJsonString(message, &json, options).ok()) json = "{}";
-  return json;
 }
 
 }  // namespace tod::server

@@ -1,5 +1,6 @@
 // Translation between the engine's values and the tod.v1 messages, shared by both frontends so
-// gRPC and REST answer with the same content (REST is the JSON form of the same message).
+// gRPC and REST answer with the same content (REST is the JSON form of the same message,
+// proto/json/message_json.h).
 #pragma once
 
 #include <string>
@@ -23,8 +24,5 @@ void FillDetectResponse(const InferenceResult& result, const std::string& frame_
                         tod::v1::DetectResponse* response);
 
 void FillModelInfo(const LoadedModel& model, tod::v1::ModelInfo* info);
-
-// Proto3 JSON with the .proto field names, defaults included; bytes become base64.
-std::string MessageToJson(const google::protobuf::Message& message);
 
 }  // namespace tod::server

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <optional>
 
+#include "server/access_log.h"
 #include "server/detect_response.h"
 #include "server/grpc_messages.h"
 #include "server/logging.h"
@@ -146,36 +147,17 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
                                            std::shared_ptr<Cancellation> cancellation,
                                            grpc::ByteBuffer* response,
                                            std::function<void(grpc::Status)> done) {
-  const std::string request_id = NextRequestId();
-  const std::string peer = context->peer();
-  auto log = [this, request_id, peer](const std::string& frame_id, size_t bytes,
-                                      const grpc::Status& status, double ms,
-                                      const char* cancelled = nullptr) {
-    const std::string code = GrpcCodeName(status.error_code());
-    metrics_.RecordRequest("grpc", code, ms / 1000.0);
-    nlohmann::json fields = {{"id", request_id}, {"protocol", "grpc"}, {"frame", frame_id},
-                             {"peer", peer},     {"bytes", bytes},     {"status", code},
-                             {"ms", ms}};
-    if (!status.ok()) fields["error"] = status.error_message();
-    if (cancelled != nullptr) fields["cancelled"] = cancelled;
-    LogEvent(status.ok() ? spdlog::level::info : spdlog::level::warn, "detect", fields);
-  };
-
+  AccessRecord access;
+  access.event = "detect";
+  access.protocol = "grpc";
+  access.id = NextRequestId();
+  access.peer = context->peer();
   // Owned here (not by gRPC) so the image bytes live until the engine's completion has run.
   auto request = std::make_shared<tod::v1::DetectRequest>();
   if (Status parsed = ParseMessage(request_bytes, request.get()); !parsed.ok()) {
-    if (context->IsCancelled()) {  // the request never arrived whole: not a malformed one
-      const grpc::Status status(grpc::StatusCode::CANCELLED,
-                                "the client cancelled the call before its request arrived");
-      log(default_frame_id.empty() ? request_id : default_frame_id, request_bytes.Length(), status,
-          0, CancelReasonName(CancelReason::kClientCancelled));
-      done(status);
-      return;
-    }
-    metrics_.RecordRejection("bad_request");
-    const grpc::Status status = ToGrpcStatus(parsed);
-    log(default_frame_id.empty() ? request_id : default_frame_id, request_bytes.Length(), status,
-        0);
+    access.frame = default_frame_id.empty() ? access.id : default_frame_id;
+    access.bytes = request_bytes.Length();
+    const grpc::Status status = RefuseUnparsed(*context, parsed, access);
     done(status);
     return;
   }
@@ -186,21 +168,47 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
   inference.encode_map_png = options.encode_map_png;
   inference.deadline = SteadyDeadline(*context);
   inference.cancellation = std::move(cancellation);
-  const std::string frame_id = !request->frame_id().empty() ? request->frame_id()
-                               : !default_frame_id.empty()  ? default_frame_id
-                                                            : request_id;
-  engine_.Submit(inference, [request, response, frame_id, log = std::move(log),
-                             done = std::move(done)](InferenceResult result) {
+  access.frame = !request->frame_id().empty() ? request->frame_id()
+                 : !default_frame_id.empty()  ? default_frame_id
+                                              : access.id;
+  access.bytes = request->image().size();
+  auto answer = [this, request, response, access, done = std::move(done)](InferenceResult result) {
     grpc::Status status = ToGrpcStatus(result.status);
     if (status.ok()) {
       tod::v1::DetectResponse message;
-      FillDetectResponse(result, frame_id, &message);
+      FillDetectResponse(result, access.frame, &message);
       status = ToGrpcStatus(SerializeMessage(message, response));
     }
-    log(frame_id, request->image().size(), status, result.total_ms,
-        result.cancelled ? CancelReasonName(*result.cancelled) : nullptr);
+    LogFrame(access, status, result.total_ms,
+             result.cancelled ? CancelReasonName(*result.cancelled) : nullptr);
     done(status);
-  });
+  };
+  engine_.Submit(inference, std::move(answer));
+}
+
+grpc::Status ObstacleDiscoveryService::RefuseUnparsed(const grpc::CallbackServerContext& context,
+                                                      const Status& parsed,
+                                                      const AccessRecord& access) {
+  if (context.IsCancelled()) {  // the request never arrived whole: not a malformed one
+    const grpc::Status status(grpc::StatusCode::CANCELLED,
+                              "the client cancelled the call before its request arrived");
+    LogFrame(access, status, 0, CancelReasonName(CancelReason::kClientCancelled));
+    return status;
+  }
+  metrics_.RecordRejection("bad_request");
+  const grpc::Status status = ToGrpcStatus(parsed);
+  LogFrame(access, status, 0);
+  return status;
+}
+
+void ObstacleDiscoveryService::LogFrame(AccessRecord access, const grpc::Status& status, double ms,
+                                        const char* cancelled) {
+  access.code = GrpcCodeName(status.error_code());
+  access.status = access.code;
+  access.ms = ms;
+  if (!status.ok()) access.error = status.error_message();
+  access.cancelled = cancelled;
+  LogAccess(access, metrics_);
 }
 
 grpc::ServerUnaryReactor* ObstacleDiscoveryService::Detect(grpc::CallbackServerContext* context,

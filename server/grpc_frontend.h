@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "server/access_log.h"
 #include "server/core/cancellation.h"
 #include "server/core/inference_engine.h"
 #include "server/core/model_holder.h"
@@ -56,6 +57,13 @@ class ObstacleDiscoveryService final : public RawObstacleDiscoveryService {
   // UNAUTHENTICATED (logged and counted) when auth is on and the call has no valid token.
   std::optional<grpc::Status> Refuse(const grpc::CallbackServerContext& context,
                                      const char* method);
+  // CANCELLED when the call was cancelled before its request arrived whole, else the parse
+  // error (INVALID_ARGUMENT, counted as bad_request); logged either way.
+  grpc::Status RefuseUnparsed(const grpc::CallbackServerContext& context, const Status& parsed,
+                              const AccessRecord& access);
+  // Writes the access-log line of a frame that ended with `status` after `ms`.
+  void LogFrame(AccessRecord access, const grpc::Status& status, double ms,
+                const char* cancelled = nullptr);
 
   InferenceEngine& engine_;
   const ModelHolder& models_;

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <optional>
 
+#include "proto/json/message_json.h"
+#include "server/access_log.h"
 #include "server/detect_response.h"
 #include "server/http/http_server.h"
 #include "server/http/query_string.h"
@@ -28,6 +31,57 @@ std::string MediaType(std::string_view content_type) {
   std::transform(type.begin(), type.end(), type.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return type;
+}
+
+// How one REST detection request ended: its answer, the gRPC code name the metrics count, and
+// the error its access-log line shows (empty: none).
+struct Outcome {
+  http::Response response;
+  std::string code;
+  std::string error;
+};
+
+// The body is an image (by its Content-Type) and the query is valid: fills `inference` and
+// `frame_id` (when the query names one); otherwise the refusal (415 or 400).
+std::optional<Outcome> ParseRequest(const http::IncomingRequest& request,
+                                    InferenceRequest* inference, std::string* frame_id) {
+  const std::string_view content_type = request.message[field::content_type];
+  const std::string media_type = MediaType(content_type);
+  if (media_type != "image/jpeg" && media_type != "image/png") {
+    const std::string message =
+        "Content-Type '" + std::string(content_type) +
+        "' is not supported; send the raw image with Content-Type image/jpeg or image/png";
+    return Outcome{http::JsonErrorResponse(415, "INVALID_ARGUMENT", message), "INVALID_ARGUMENT",
+                   message};
+  }
+  inference->image = request.message.body();
+  inference->cancellation = request.client_gone;
+  if (Status s = ParseDetectQuery(http::ParseQuery(request.message.target()), inference, frame_id);
+      !s.ok()) {
+    return Outcome{http::JsonErrorResponse(400, "INVALID_ARGUMENT", s.message()),
+                   "INVALID_ARGUMENT", s.message()};
+  }
+  return std::nullopt;
+}
+
+// The access-log record of a detection request that ended with `outcome`.
+AccessRecord RestAccess(const http::IncomingRequest& request, const std::string& request_id,
+                        bool map_only, const std::string& frame_id, const Outcome& outcome,
+                        std::chrono::steady_clock::time_point started) {
+  AccessRecord access;
+  access.event = map_only ? "probability-map" : "detect";
+  access.protocol = "http";
+  access.id = request_id;
+  access.path = std::string(http::TargetPath(request.message.target()));
+  access.frame = frame_id;
+  access.peer = request.peer;
+  access.bytes = request.message.body().size();
+  access.status = outcome.response.result_int();
+  access.code = outcome.code;
+  access.ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+  if (!outcome.error.empty()) access.error = outcome.error;
+  return access;
 }
 
 }  // namespace
@@ -74,7 +128,7 @@ class RestApi {
     tod::v1::ModelInfo info;
     FillModelInfo(*model, &info);
     metrics_.RecordRequest("http", "OK", 0);
-    return http::ContentResponse(MessageToJson(info), kJson);
+    return http::ContentResponse(proto::MessageToJson(info), kJson);
   }
 
   void Detect(http::IncomingRequest incoming, http::Responder respond, bool map_only) const {
@@ -82,80 +136,52 @@ class RestApi {
     auto request = std::make_shared<const http::IncomingRequest>(std::move(incoming));
     const auto started = std::chrono::steady_clock::now();
     const std::string request_id = "h" + std::to_string(++counter_);
-    const std::string path(http::TargetPath(request->message.target()));
-    const char* event = map_only ? "probability-map" : "detect";
-    auto finish = [this, started, request_id, path, event, request, respond](
-                      http::Response response, const std::string& code, const std::string& error,
-                      const std::string& frame_id) {
-      const double ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
-              .count();
-      metrics_.RecordRequest("http", code, ms / 1000.0);
-      nlohmann::json fields = {{"id", request_id},
-                               {"protocol", "http"},
-                               {"path", path},
-                               {"frame", frame_id},
-                               {"peer", request->peer},
-                               {"bytes", request->message.body().size()},
-                               {"status", response.result_int()},
-                               {"ms", ms}};
-      if (!error.empty()) fields["error"] = error;
-      LogEvent(error.empty() ? spdlog::level::info : spdlog::level::warn, event, fields);
-      respond(std::move(response));
+    // Logs the request's line, then sends its answer.
+    auto finish = [this, started, request_id, map_only, request, respond](
+                      Outcome outcome, const std::string& frame_id) {
+      LogAccess(RestAccess(*request, request_id, map_only, frame_id, outcome, started), metrics_);
+      respond(std::move(outcome.response));
     };
 
-    const std::string_view content_type = request->message[field::content_type];
-    const std::string media_type = MediaType(content_type);
-    if (media_type != "image/jpeg" && media_type != "image/png") {
-      const std::string message =
-          "Content-Type '" + std::string(content_type) +
-          "' is not supported; send the raw image with Content-Type image/jpeg or image/png";
-      metrics_.RecordRejection("bad_request");
-      finish(http::JsonErrorResponse(415, "INVALID_ARGUMENT", message), "INVALID_ARGUMENT", message,
-             request_id);
-      return;
-    }
     InferenceRequest inference;
-    inference.image = request->message.body();
-    inference.cancellation = request->client_gone;
     std::string frame_id = request_id;
-    if (Status s =
-            ParseDetectQuery(http::ParseQuery(request->message.target()), &inference, &frame_id);
-        !s.ok()) {
+    if (std::optional<Outcome> refused = ParseRequest(*request, &inference, &frame_id)) {
       metrics_.RecordRejection("bad_request");
-      finish(http::JsonErrorResponse(400, "INVALID_ARGUMENT", s.message()), "INVALID_ARGUMENT",
-             s.message(), frame_id);
+      finish(std::move(*refused), frame_id);
       return;
     }
     if (map_only) inference.encode_map_png = true;
 
     // Runs on a worker (or inline when refused at admission); never blocks an I/O thread.
     engine_.Submit(inference, [this, finish, frame_id, map_only](InferenceResult result) {
-      const std::string code = GrpcCodeName(ToGrpcCode(result.status.code()));
-      if (!result.status.ok()) {
-        http::Response response = http::JsonErrorResponse(
-            HttpStatusFor(result.status, result.rejection), code, result.status.message());
-        if (result.rejection == Rejection::kQueueFull) {
-          response.set(field::retry_after, std::to_string(config_.retry_after_s));
-        }
-        finish(std::move(response), code, result.status.message(), frame_id);
-        return;
-      }
-      if (map_only) {
-        if (result.map_png.empty()) {
-          finish(http::JsonErrorResponse(500, "INTERNAL", "the pipeline produced no map"),
-                 "INTERNAL", "no probability map", frame_id);
-          return;
-        }
-        http::Response response = http::ContentResponse(std::move(result.map_png), "image/png");
-        response.set("X-Model-Version", result.model->detector->info().version);
-        finish(std::move(response), code, "", frame_id);
-        return;
-      }
-      tod::v1::DetectResponse message;
-      FillDetectResponse(result, frame_id, &message);
-      finish(http::ContentResponse(MessageToJson(message), kJson), code, "", frame_id);
+      finish(Answer(std::move(result), frame_id, map_only), frame_id);
     });
+  }
+
+  // The REST answer to an engine result: the error (with Retry-After when the queue was full),
+  // the map as PNG, or the DetectResponse as JSON.
+  Outcome Answer(InferenceResult result, const std::string& frame_id, bool map_only) const {
+    const std::string code = GrpcCodeName(ToGrpcCode(result.status.code()));
+    if (!result.status.ok()) {
+      http::Response response = http::JsonErrorResponse(
+          HttpStatusFor(result.status, result.rejection), code, result.status.message());
+      if (result.rejection == Rejection::kQueueFull) {
+        response.set(field::retry_after, std::to_string(config_.retry_after_s));
+      }
+      return {std::move(response), code, result.status.message()};
+    }
+    if (map_only) {
+      if (result.map_png.empty()) {
+        return {http::JsonErrorResponse(500, "INTERNAL", "the pipeline produced no map"),
+                "INTERNAL", "no probability map"};
+      }
+      http::Response response = http::ContentResponse(std::move(result.map_png), "image/png");
+      response.set("X-Model-Version", result.model->detector->info().version);
+      return {std::move(response), code, ""};
+    }
+    tod::v1::DetectResponse message;
+    FillDetectResponse(result, frame_id, &message);
+    return {http::ContentResponse(proto::MessageToJson(message), kJson), code, ""};
   }
 
   const HttpFrontendConfig& config_;

@@ -94,31 +94,38 @@ void ServerMetrics::RecordRejection(const std::string& reason) {
   rejections_.Add({{"reason", reason}}).Increment();
 }
 
-void ServerMetrics::RecordCancelled(const std::string& reason) {
-  cancelled_.Add({{"reason", reason}}).Increment();
-}
-
-void ServerMetrics::RecordDegraded(const std::string& stage) {
-  degraded_.Add({{"stage", stage}}).Increment();
-}
-
 void ServerMetrics::RecordHttpRefusal(const std::string& reason) {
   http_refused_.Add({{"reason", reason}}).Increment();
 }
 
 void ServerMetrics::SetHttpConnections(double open) { http_connections_.Set(open); }
 
-void ServerMetrics::ObserveQueueWait(double seconds) { queue_duration_.Observe(seconds); }
-
-void ServerMetrics::ObserveStages(const StageTimes& stages) {
-  for (const auto& [stage, ms] : stages) {
-    stage_duration_.Add({{"stage", stage}}, LatencyBuckets()).Observe(ms / 1000.0);
-  }
+void ServerMetrics::OnAccepted(size_t queue_depth) {
+  queue_depth_.Set(static_cast<double>(queue_depth));
+  in_flight_.Increment();
 }
 
-void ServerMetrics::SetQueueDepth(double depth) { queue_depth_.Set(depth); }
+void ServerMetrics::OnQueueDepth(size_t queue_depth) {
+  queue_depth_.Set(static_cast<double>(queue_depth));
+}
 
-void ServerMetrics::AddInFlight(double delta) { in_flight_.Increment(delta); }
+void ServerMetrics::OnStarted(double queue_ms) { queue_duration_.Observe(queue_ms / 1000.0); }
+
+void ServerMetrics::OnFinished() { in_flight_.Decrement(); }
+
+void ServerMetrics::OnRejected(Rejection rejection) { RecordRejection(RejectionName(rejection)); }
+
+void ServerMetrics::OnCancelled(CancelReason reason) {
+  cancelled_.Add({{"reason", CancelReasonName(reason)}}).Increment();
+}
+
+void ServerMetrics::OnDetected(const StageTimes& timings,
+                               const std::vector<std::string>& degraded_stages) {
+  for (const auto& [stage, ms] : timings) {
+    stage_duration_.Add({{"stage", stage}}, LatencyBuckets()).Observe(ms / 1000.0);
+  }
+  for (const std::string& stage : degraded_stages) degraded_.Add({{"stage", stage}}).Increment();
+}
 
 void ServerMetrics::SetModel(const std::string& name, const std::string& version, int generation) {
   // One series only: drop the previous model's labels.

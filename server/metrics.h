@@ -11,29 +11,36 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "core/base/stage_timer.h"
+#include "server/core/engine_observer.h"
 
 namespace tod::server {
 
-class ServerMetrics {
+// The engine's events arrive through EngineObserver; the front ends, the HTTP transport and the
+// model and token reloads call the Record*/Set* methods themselves.
+class ServerMetrics final : public EngineObserver {
  public:
   ServerMetrics();
 
+  // EngineObserver: queue depth and in-flight gauges, queue wait and stage histograms,
+  // rejections ("reason" = RejectionName), cancellations ("reason" = CancelReasonName) and
+  // frames the budget cut short ("stage").
+  void OnAccepted(size_t queue_depth) override;
+  void OnQueueDepth(size_t queue_depth) override;
+  void OnStarted(double queue_ms) override;
+  void OnFinished() override;
+  void OnRejected(Rejection rejection) override;
+  void OnCancelled(CancelReason reason) override;
+  void OnDetected(const StageTimes& timings,
+                  const std::vector<std::string>& degraded_stages) override;
+
   // One finished request. protocol: "grpc" | "http"; code: the gRPC code name ("OK", ...).
   void RecordRequest(const std::string& protocol, const std::string& code, double seconds);
-  // A request refused before or instead of running: "queue_full", "too_large", "bad_image",
-  // "not_ready", "deadline", "bad_request".
+  // A request refused before it reached the engine, or by the engine (OnRejected):
+  // "unauthenticated", "bad_request", or a RejectionName.
   void RecordRejection(const std::string& reason);
-  // A request whose work was stopped or skipped because its caller gave up or the drain timeout
-  // came: "deadline", "client_cancelled", "client_disconnected", "drain" (CancelReasonName).
-  void RecordCancelled(const std::string& reason);
-  // The frame budget cut a stage of a request short ("proposals", "regression").
-  void RecordDegraded(const std::string& stage);
-  void ObserveQueueWait(double seconds);
-  void ObserveStages(const StageTimes& stages);  // milliseconds in, seconds exported
-  void SetQueueDepth(double depth);
-  void AddInFlight(double delta);
   // The HTTP transport refused a request or connection (http::RefusalReasonName).
   void RecordHttpRefusal(const std::string& reason);
   void SetHttpConnections(double open);

@@ -47,7 +47,7 @@ Result<std::optional<double>> RealParam(const QueryParams& query, const std::str
 Status ParseDetectQuery(const QueryParams& query, InferenceRequest* inference,
                         std::string* frame_id) {
   const Result<std::optional<long long>> proposals =
-      IntegerParam(query, "max_proposals", 0, kMaxRestProposals);
+      IntegerParam(query, "max_proposals", 0, kMaxRequestProposals);
   if (!proposals.ok()) return proposals.status();
   if (*proposals) inference->options.max_proposals = static_cast<int>(**proposals);
 

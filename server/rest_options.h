@@ -4,7 +4,8 @@
 //   budget_ms      integer 1..600000 (lowers the server's frame budget)
 //   frame_id       text
 // A value out of range or not a number is an InvalidArgument naming the parameter; nothing can
-// overflow (numbers are parsed into wide types and checked before use).
+// overflow (numbers are parsed into wide types and checked before use). The bounds gRPC shares
+// (max_proposals, budget_ms) are the engine's: kMaxRequestProposals, kMaxRequestBudgetMs.
 #pragma once
 
 #include <map>
@@ -16,7 +17,6 @@
 namespace tod::server {
 
 inline constexpr long long kMaxRestTimeoutMs = 3'600'000;  // one hour
-inline constexpr long long kMaxRestProposals = 10'000;     // as the proto documents
 
 using QueryParams = std::map<std::string, std::string, std::less<>>;
 

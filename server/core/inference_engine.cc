@@ -6,7 +6,6 @@
 
 #include "core/pipeline/frame_budget.h"
 #include "server/core/image_header.h"
-#include "server/metrics.h"
 
 namespace tod::server {
 namespace {
@@ -97,33 +96,9 @@ std::optional<InferenceResult> RunDetector(const Detector& detector, const cv::M
 
 }  // namespace
 
-const char* RejectionName(Rejection rejection) {
-  switch (rejection) {
-    case Rejection::kNone:
-      return "none";
-    case Rejection::kNotReady:
-      return "not_ready";
-    case Rejection::kQueueFull:
-      return "queue_full";
-    case Rejection::kTooLarge:
-      return "too_large";
-    case Rejection::kBadImage:
-      return "bad_image";
-    case Rejection::kBadRequest:
-      return "bad_request";
-    case Rejection::kDeadline:
-      return "deadline";
-    case Rejection::kCancelled:
-      return "cancelled";
-    case Rejection::kInternal:
-      return "internal";
-  }
-  return "unknown";
-}
-
 InferenceEngine::InferenceEngine(EngineConfig config, const ModelHolder& models,
-                                 ServerMetrics* metrics)
-    : config_(std::move(config)), models_(models), metrics_(metrics) {}
+                                 EngineObserver* observer)
+    : config_(std::move(config)), models_(models), observer_(observer) {}
 
 InferenceEngine::~InferenceEngine() { Stop(); }
 
@@ -134,10 +109,9 @@ void InferenceEngine::Start() {
 }
 
 Status InferenceEngine::ValidateOptions(const DetectOptions& options) const {
-  if (options.max_proposals < 0 || options.max_proposals > config_.max_proposals_cap) {
+  if (options.max_proposals < 0 || options.max_proposals > kMaxRequestProposals) {
     return Status::InvalidArgument("max_proposals: " + std::to_string(options.max_proposals) +
-                                   " is outside [0, " + std::to_string(config_.max_proposals_cap) +
-                                   "]");
+                                   " is outside [0, " + std::to_string(kMaxRequestProposals) + "]");
   }
   if (!(options.obstacle_threshold >= 0.f && options.obstacle_threshold <= 1.f)) {
     return Status::InvalidArgument(
@@ -159,12 +133,10 @@ Status InferenceEngine::ValidateOptions(const DetectOptions& options) const {
 void InferenceEngine::Finish(Completion& done, InferenceResult result,
                              Clock::time_point submitted) const {
   result.total_ms = MillisecondsSince(submitted);
-  if (metrics_ != nullptr && result.rejection != Rejection::kNone) {
-    metrics_->RecordRejection(RejectionName(result.rejection));
+  if (observer_ != nullptr && result.rejection != Rejection::kNone) {
+    observer_->OnRejected(result.rejection);
   }
-  if (metrics_ != nullptr && result.cancelled) {
-    metrics_->RecordCancelled(CancelReasonName(*result.cancelled));
-  }
+  if (observer_ != nullptr && result.cancelled) observer_->OnCancelled(*result.cancelled);
   done(std::move(result));
 }
 
@@ -220,10 +192,7 @@ void InferenceEngine::Submit(const InferenceRequest& request, Completion done) {
     std::shared_ptr<Cancellation> cancellation =
         request.cancellation ? request.cancellation : std::make_shared<Cancellation>();
     queue_.push_back(Job{request, std::move(done), submitted, std::move(cancellation)});
-    if (metrics_ != nullptr) {
-      metrics_->SetQueueDepth(static_cast<double>(queue_.size()));
-      metrics_->AddInFlight(1);
-    }
+    if (observer_ != nullptr) observer_->OnAccepted(queue_.size());
   }
   work_available_.notify_one();
 }
@@ -245,7 +214,7 @@ void InferenceEngine::WorkerLoop() {
       ++running_;
       running_cancellations_.push_back(job.cancellation);
       stop_now = stopping_;
-      if (metrics_ != nullptr) metrics_->SetQueueDepth(static_cast<double>(queue_.size()));
+      if (observer_ != nullptr) observer_->OnQueueDepth(queue_.size());
     }
     InferenceResult result;
     if (stop_now) {  // Stop() came before this job could start
@@ -256,7 +225,7 @@ void InferenceEngine::WorkerLoop() {
     }
     // Out of the gauge before the answer goes out: a client that has its answer must never see
     // its request still in flight.
-    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
+    if (observer_ != nullptr) observer_->OnFinished();
     Finish(job.done, std::move(result), job.submitted);
     {
       std::lock_guard lock(mutex_);
@@ -269,7 +238,7 @@ void InferenceEngine::WorkerLoop() {
 
 InferenceResult InferenceEngine::Run(const Job& job) const {
   const double queue_ms = MillisecondsSince(job.submitted);
-  if (metrics_ != nullptr) metrics_->ObserveQueueWait(queue_ms / 1000.0);
+  if (observer_ != nullptr) observer_->OnStarted(queue_ms);
   const InferenceRequest& request = job.request;
   Cancellation& cancellation = *job.cancellation;
   if (const std::optional<CancelReason> reason = StopReason(cancellation, request.deadline)) {
@@ -319,11 +288,7 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
     result.map_png = std::move(*png);
     result.timings.emplace_back("encode_map", MillisecondsSince(encode_start));
   }
-  if (metrics_ != nullptr) {
-    metrics_->ObserveStages(result.timings);
-    for (const std::string& stage : result.detection.degraded_stages)
-      metrics_->RecordDegraded(stage);
-  }
+  if (observer_ != nullptr) observer_->OnDetected(result.timings, result.detection.degraded_stages);
   return result;
 }
 
@@ -361,11 +326,11 @@ void InferenceEngine::CancelAll(CancelReason reason) {
     for (const std::shared_ptr<Cancellation>& running : running_cancellations_) {
       running->Cancel(reason);
     }
-    if (metrics_ != nullptr) metrics_->SetQueueDepth(0);
+    if (observer_ != nullptr) observer_->OnQueueDepth(0);
   }
   for (Job& job : queued) {
     job.cancellation->Cancel(reason);
-    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
+    if (observer_ != nullptr) observer_->OnFinished();
     Finish(job.done, Stopped(*job.cancellation->reason(), "while the request was queued"),
            job.submitted);
   }
@@ -388,7 +353,7 @@ void InferenceEngine::Stop() {
     leftover.swap(queue_);
   }
   for (Job& job : leftover) {
-    if (metrics_ != nullptr) metrics_->AddInFlight(-1);
+    if (observer_ != nullptr) observer_->OnFinished();
     Finish(job.done,
            Refusal(Status::Unavailable("server shut down before the request ran"),
                    Rejection::kNotReady),

@@ -25,27 +25,12 @@
 #include "core/base/status.h"
 #include "core/pipeline/detector.h"
 #include "server/core/cancellation.h"
+#include "server/core/engine_observer.h"
 #include "server/core/image_codec.h"
 #include "server/core/model_holder.h"
+#include "server/core/rejection.h"
 
 namespace tod::server {
-
-class ServerMetrics;
-
-// Why a request did not produce a detection; the frontends map it onto protocol codes.
-enum class Rejection {
-  kNone,
-  kNotReady,    // no model yet, or draining          -> UNAVAILABLE / 503
-  kQueueFull,   //                                    -> RESOURCE_EXHAUSTED / 503 + Retry-After
-  kTooLarge,    // byte or pixel limit                -> RESOURCE_EXHAUSTED / 413
-  kBadImage,    // empty / undecodable                -> INVALID_ARGUMENT / 400
-  kBadRequest,  // invalid option                     -> INVALID_ARGUMENT / 400
-  kDeadline,    // deadline passed (queued or running) -> DEADLINE_EXCEEDED / 504
-  kCancelled,   // client gone, or the drain timeout   -> CANCELLED / 499, UNAVAILABLE / 503
-  kInternal,    // pipeline failure                   -> INTERNAL / 500
-};
-// Stable lower-case name, used as the metrics label "reason".
-const char* RejectionName(Rejection rejection);
 
 struct InferenceRequest {
   std::string_view image;  // encoded JPEG/PNG; must stay valid until the completion has run
@@ -71,6 +56,9 @@ using Completion = std::function<void(InferenceResult)>;
 
 // A request's budget_ms option, when set, must lie in [1, this].
 inline constexpr long long kMaxRequestBudgetMs = 600'000;
+// A request's max_proposals option must lie in [0, this], on gRPC and REST alike (the proto
+// documents the range; the REST query parser and the engine's admission check both use this).
+inline constexpr int kMaxRequestProposals = 10'000;
 
 struct EngineConfig {
   int workers = 1;
@@ -80,13 +68,12 @@ struct EngineConfig {
   int threads_per_request = 1;  // cores one request may use (DetectOptions::threads)
   int queue_capacity = 16;      // requests waiting (not counting the ones running)
   ImageLimits limits;
-  int max_proposals_cap = 10000;  // options above this are refused
 };
 
 class InferenceEngine {
  public:
-  // `models` and `metrics` (nullable) must outlive the engine.
-  InferenceEngine(EngineConfig config, const ModelHolder& models, ServerMetrics* metrics);
+  // `models` and `observer` (nullable: nobody listens) must outlive the engine.
+  InferenceEngine(EngineConfig config, const ModelHolder& models, EngineObserver* observer);
   ~InferenceEngine();
   InferenceEngine(const InferenceEngine&) = delete;
   InferenceEngine& operator=(const InferenceEngine&) = delete;
@@ -132,7 +119,7 @@ class InferenceEngine {
 
   const EngineConfig config_;
   const ModelHolder& models_;
-  ServerMetrics* const metrics_;
+  EngineObserver* const observer_;
 
   mutable std::mutex mutex_;  // guards everything below
   std::condition_variable work_available_;

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "core/pipeline/detector.h"
+#include "proto/json/message_json.h"
 #include "server/core/inference_engine.h"
 #include "server/core/model_holder.h"
 #include "server/detect_response.h"
@@ -76,7 +77,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Check(!parsed.message().empty());
     return 0;
   }
-  (void)tod::server::MessageToJson(request);
+  (void)tod::proto::MessageToJson(request);
 
   const tod::server::RequestOptions options = tod::server::OptionsFromProto(request.options());
   tod::server::InferenceRequest inference;

@@ -70,7 +70,7 @@ void HandleDetect(const tod::server::http::Request& request) {
   const tod::Status status = tod::server::ParseDetectQuery(query, &inference, &frame_id);
   if (status.ok()) {
     const tod::DetectOptions& options = inference.options;
-    Check(options.max_proposals >= 0 && options.max_proposals <= tod::server::kMaxRestProposals);
+    Check(options.max_proposals >= 0 && options.max_proposals <= tod::server::kMaxRequestProposals);
     Check(options.obstacle_threshold >= 0.f && options.obstacle_threshold <= 1.f);
     // Only the two named kinds parse; any other value was refused above.
     Check(options.map_kind == tod::MapKind::kNormalized ||

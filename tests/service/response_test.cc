@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "proto/json/message_json.h"
 #include "server/detect_response.h"
 #include "server/status_mapping.h"
 #include "tests/service/fake_detectors.h"
@@ -26,7 +27,7 @@ TEST(DetectResponseTest, CarriesEveryFieldIntoJson) {
 
   tod::v1::DetectResponse response;
   FillDetectResponse(result, "frame-3", &response);
-  const nlohmann::json json = nlohmann::json::parse(MessageToJson(response));
+  const nlohmann::json json = nlohmann::json::parse(proto::MessageToJson(response));
   EXPECT_EQ(json["frame_id"], "frame-3");
   EXPECT_EQ(json["model_version"], "v7");
   EXPECT_EQ(json["width"], 40);
