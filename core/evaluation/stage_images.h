@@ -1,7 +1,8 @@
 // `tod detect --stages`: the intermediate results of one frame as pictures and counts, so that a
-// person can see at which stage an obstacle is lost. They are drawn from the detection's own
-// FrameTrace (ObstacleDetector::Detect with a trace), so they show exactly what the detection was
-// made from, at the cost of the drawing alone.
+// person can see at which stage an obstacle is lost. The stages are run again here with the same
+// public stage functions, parameters and geometry the detector uses (GeometryForFrame,
+// ComputeOcclusionEdges with enhancement, ProposeRegionBoxes per region); they are deterministic,
+// so the pictures show exactly what the detection was made from.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -10,7 +11,7 @@
 #include <vector>
 
 #include "core/base/status.h"
-#include "core/pipeline/frame_trace.h"
+#include "core/pipeline/model_bundle.h"
 
 namespace tod {
 
@@ -52,8 +53,8 @@ struct StageImages {
   nlohmann::json counts;
 };
 
-// `trace` is what ObstacleDetector::Detect filled for `bgr`.
-Result<StageImages> RenderStageImages(const FrameTrace& trace, const cv::Mat3b& bgr,
+// Needs a frame of at least 16 x 16 pixels, as Detector::Detect does.
+Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b& bgr,
                                       const StageImageOptions& options = {});
 
 // Writes base_path + "_stage_<name>.png" for each picture and base_path + "_stages.json", each
