@@ -1,12 +1,11 @@
 // tod detect --model MODEL_DIR IMAGE... --out DIR: per image STEM, STEM.json, STEM_prob.png
 // (probability map, 255 = 1.0) and STEM_overlay.png; with --stages also the pictures and counts
-// of the intermediate stages (core/pipeline/stage_images.h).
+// of the intermediate stages (core/evaluation/stage_images.h).
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
-#include <optional>
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
@@ -15,7 +14,7 @@
 #include "core/evaluation/stage_images.h"
 #include "core/pipeline/detection_output.h"
 #include "core/pipeline/frame_budget.h"
-#include "core/pipeline/model_bundle.h"
+#include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/warm_up.h"
 
 namespace tod::cli {
@@ -65,18 +64,18 @@ DetectOptions OptionsAfterDecode(DetectOptions options,
   return options;
 }
 
-// STEM.json, STEM_prob.png, STEM_overlay.png and, with a stage bundle, the stage pictures.
+// STEM.json, STEM_prob.png, STEM_overlay.png and, with a trace, the stage pictures.
 Status WriteDetectOutputs(const std::filesystem::path& base, const std::string& path,
                           const cv::Mat3b& image, const Detection& detection,
-                          const std::optional<ModelBundle>& stage_bundle) {
+                          const FrameTrace* trace) {
   Status st =
       WriteFileAtomically(base.string() + ".json", DetectionToJson(detection, path).dump(2) + "\n");
   if (st.ok())
     st = WritePngAtomically(base.string() + "_prob.png", ProbabilityTo8Bit(detection.probability));
   if (st.ok())
     st = WritePngAtomically(base.string() + "_overlay.png", DrawOverlay(image, detection));
-  if (!st.ok() || !stage_bundle) return st;
-  auto stages = RenderStageImages(*stage_bundle, image);
+  if (!st.ok() || trace == nullptr) return st;
+  auto stages = RenderStageImages(*trace, image);
   if (!stages.ok()) return stages.status();
   stages->counts["image"] = path;
   return WriteStageImages(*stages, base.string());
@@ -84,8 +83,8 @@ Status WriteDetectOutputs(const std::filesystem::path& base, const std::string& 
 
 // One image file. A frame that cannot be read or detected is reported and counted in
 // `failures` (the run goes on with the next); a failed write ends the run.
-Status DetectFile(const Detector& detector, const std::optional<ModelBundle>& stage_bundle,
-                  const DetectArgs& args, const std::string& path, int& failures) {
+Status DetectFile(const ObstacleDetector& detector, const DetectArgs& args, const std::string& path,
+                  int& failures) {
   const auto read_start = std::chrono::steady_clock::now();
   // Decoded as tod_server and tod bench decode (plain PNGs without libpng).
   const Result<cv::Mat> read = ReadImageFile(path, cv::IMREAD_COLOR, "image");
@@ -95,7 +94,10 @@ Status DetectFile(const Detector& detector, const std::optional<ModelBundle>& st
     return Status::Ok();
   }
   const cv::Mat& image = *read;
-  auto detection = detector.Detect(image, OptionsAfterDecode(args.options, read_start));
+  // With --stages the detection's own trace is drawn: the stages run once.
+  FrameTrace trace;
+  FrameTrace* const traced = args.stages ? &trace : nullptr;
+  auto detection = detector.Detect(image, OptionsAfterDecode(args.options, read_start), traced);
   if (!detection.ok()) {
     std::cerr << "tod: " << path << ": " << detection.status().message() << "\n";
     ++failures;
@@ -103,14 +105,13 @@ Status DetectFile(const Detector& detector, const std::optional<ModelBundle>& st
   }
   const std::string stem = std::filesystem::path(path).stem().string();
   const std::filesystem::path base = std::filesystem::path(args.out) / stem;
-  if (Status st = WriteDetectOutputs(base, path, image, *detection, stage_bundle); !st.ok())
-    return st;
+  if (Status st = WriteDetectOutputs(base, path, image, *detection, traced); !st.ok()) return st;
   double total = 0;
   for (const auto& [stage, ms] : detection->timings) total += ms;
   std::cout << path << ": " << detection->obstacles.size() << " obstacles, "
             << detection->proposals.size() << " proposals listed, " << static_cast<int>(total)
             << " ms -> " << base.string() << "{.json,_prob.png,_overlay.png"
-            << (stage_bundle ? ",_stage_*.png,_stages.json" : "") << "}\n";
+            << (args.stages ? ",_stage_*.png,_stages.json" : "") << "}\n";
   return Status::Ok();
 }
 
@@ -121,25 +122,20 @@ Runner AddDetectCommand(CLI::App& app) {
   AddDetectOptions(app.add_subcommand("detect", "find obstacles in images"), args);
   return [args] {
     UseRequestThreadsForOpenCv(args->options);
-    auto detector = Detector::Load(args->model);
-    if (!detector.ok()) return Fail(detector.status().message());
+    auto loaded = Detector::Load(args->model);
+    if (!loaded.ok()) return Fail(loaded.status().message());
+    // The stage pictures need the detector's trace, which only the bundle's own detector keeps.
+    const auto detector = std::dynamic_pointer_cast<const ObstacleDetector>(*loaded);
+    if (detector == nullptr) return Fail(args->model + ": not an obstacle detector bundle");
     // One-off costs of the process (warm_up.h) are paid here, not by the first frame's budget.
-    if (const Result<double> warmed = WarmUp(**detector); !warmed.ok())
+    if (const Result<double> warmed = WarmUp(*detector); !warmed.ok())
       return Fail(warmed.status().message());
-    // The Detector interface hides its bundle, so the stage pictures get their own copy of the
-    // same bundle (loaded only with --stages).
-    std::optional<ModelBundle> stage_bundle;
-    if (args->stages) {
-      auto bundle = LoadModelBundle(args->model);
-      if (!bundle.ok()) return Fail(bundle.status().message());
-      stage_bundle = std::move(*bundle);
-    }
     std::error_code ec;
     std::filesystem::create_directories(args->out, ec);
     if (ec) return Fail("cannot create " + args->out + ": " + ec.message());
     int failures = 0;
     for (const std::string& path : args->images) {
-      const Status st = DetectFile(**detector, stage_bundle, *args, path, failures);
+      const Status st = DetectFile(*detector, *args, path, failures);
       if (!st.ok()) return Fail(st.message());
     }
     return failures == 0 ? 0 : 1;

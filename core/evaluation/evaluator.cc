@@ -146,12 +146,13 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   const Dataset& dataset = *selection->dataset;
   const int n = static_cast<int>(selection->frames.size());
   EvalTotals totals(bundle.params.obstacle_calibration.fitted);
+  const ObstacleDetector detector(bundle, "eval");  // one copy of the bundle for the run
   std::mutex mutex;
   int done = 0;
   const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
     const auto loaded = dataset.Load(selection->frames[i]);
     if (!loaded.ok()) return loaded.status();
-    const Result<FrameEvaluation> frame = EvaluateFrame(bundle, *loaded);
+    const Result<FrameEvaluation> frame = EvaluateFrame(detector, *loaded);
     if (!frame.ok()) return frame.status();
     std::lock_guard lock(mutex);
     if (Status st = totals.Add(*frame, *loaded); !st.ok()) return st;

@@ -42,53 +42,42 @@ std::string ContractName(const std::string& detector_stage) {
   return detector_stage == "probability_map" ? "map" : detector_stage;
 }
 
-// The work counters and the Edge Boxes baseline, on a separate pass with the detector's own
-// stage calls and parameters (ObstacleDetector::Detect), so the timed call carries no counting.
-Status CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchRecord& record) {
-  const FrameGeometry geometry = GeometryForFrame(bundle, bgr.cols, bgr.rows);
-  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-      bgr, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, bgr.cols, bgr.rows), bundle.params, /*enhance=*/true);
-  if (!computed.ok()) return computed.status().WithContext("counting the work");
-  const OcclusionEdges& oaocc = *computed;
-  const SizeFilter* size_filter = bundle.params.size_filter ? &geometry.size_filter : nullptr;
-  std::vector<RegionProposals> per_region;
-  for (int k = 0; k < geometry.regions.num_layers(); ++k) {
-    EdgeBoxStats stats;
-    per_region.push_back(ProposeRegionBoxes(oaocc, geometry.regions, bundle.params.boxes, k,
-                                            bundle.params.multistride, size_filter, &stats));
+// The work counters of the timed call's own stages (its trace), and the Edge Boxes baseline
+// on the base edges those stages computed.
+void CountWork(const FrameTrace& trace, FrameBenchRecord& record) {
+  for (const EdgeBoxStats& stats : trace.regions.stats) {
     record.windows_scored += stats.windows_visited;
     record.windows_walked += stats.windows_past_early_exit;
     record.edge_groups += stats.edge_groups;
     record.edge_pixels += stats.edge_pixels;
   }
-  record.proposals = static_cast<long long>(
-      MergeRegionBoxes(per_region, bundle.params.region_merge_iou).boxes.size());
+  record.proposals =
+      static_cast<long long>(trace.regressed.proposals.boxes.size() + trace.regressed.dropped);
 
   // E is the same map with or without the obstacle-aware enhancement, so the baseline scores
   // exactly the base edges our proposals start from. Its time includes the orientation and the
   // edge thinning it needs (edge_boxes_baseline.h), not the edge map itself.
   const Clock::time_point start = Clock::now();
-  const std::vector<Box> boxes = EdgeBoxesBaseline(oaocc.base_edge, oaocc.r1, kEdgeBoxesMax);
+  const std::vector<Box> boxes =
+      EdgeBoxesBaseline(trace.oaocc.base_edge, trace.oaocc.r1, kEdgeBoxesMax);
   record.edgeboxes_ms = MsBetween(start, Clock::now());
   record.edgeboxes_boxes = static_cast<long long>(boxes.size());
-  return Status::Ok();
 }
 
-// The timed part: decode, the detector's call exactly as `tod detect` makes it, and the map
-// encoded as `tod detect` writes it. The decoded frame is handed back for the counting pass; the
-// detection is released here, so its maps are not held while the counting pass runs.
+// The timed part: decode, the detector's call as `tod detect` makes it, and the map encoded as
+// `tod detect` writes it. The call's trace is handed back for the counters (keeping it costs the
+// call nothing: it holds what the stages made anyway); the detection is released here.
 Result<FrameBenchRecord> TimeFrame(const ObstacleDetector& detector, const std::string& bytes,
-                                   const DetectOptions& options, cv::Mat3b& bgr) {
+                                   const DetectOptions& options, FrameTrace& trace) {
   const Clock::time_point start = Clock::now();
   Result<cv::Mat3b> decoded = DecodeColourImage(bytes);
   const Clock::time_point decoded_at = Clock::now();
   if (!decoded.ok()) return decoded.status();
-  bgr = std::move(decoded).value();
+  const cv::Mat3b bgr = std::move(decoded).value();
   // The frame budget counts from the start of decoding, as the server counts it.
   DetectOptions detect = options;
   detect.budget_ms = BudgetLeftMs(detect.budget_ms, MsBetween(start, decoded_at));
-  const auto detection = detector.Detect(bgr, detect);
+  const auto detection = detector.Detect(bgr, detect, &trace);
   if (!detection.ok()) return detection.status();
   const Clock::time_point encode_start = Clock::now();
   std::vector<uchar> png;
@@ -113,11 +102,11 @@ Result<FrameBenchRecord> MeasureFrame(const ObstacleDetector& detector, const st
   // Reading the file is the storage's time, not ours: done before the clock starts.
   const Result<std::string> bytes = ReadFileBytes(path);
   if (!bytes.ok()) return bytes.status();
-  cv::Mat3b bgr;
-  auto record = TimeFrame(detector, *bytes, options, bgr);
+  FrameTrace trace;
+  auto record = TimeFrame(detector, *bytes, options, trace);
   if (!record.ok()) return record.status();
   record->frame = path;
-  if (Status counted = CountWork(detector.bundle(), bgr, *record); !counted.ok()) return counted;
+  CountWork(trace, *record);
   return record;
 }
 

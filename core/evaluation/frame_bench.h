@@ -8,9 +8,9 @@
 // clock from the start of decode to the end of encode_map, so it also holds the little the
 // detector does between its timed stages.
 //
-// The counters (windows scored, edge groups, edge pixels) and the Edge Boxes baseline come from a
-// second, separate pass over the same decoded frame with the detector's own stage functions and
-// parameters (as `tod detect --stages` does), so that counting never slows the timed call.
+// The counters (windows scored, edge groups, edge pixels, proposals) are the timed call's own
+// (its FrameTrace), and the Edge Boxes baseline runs after it, untimed by the frame's stages, on
+// the base edge map that call computed.
 #pragma once
 
 #include <functional>

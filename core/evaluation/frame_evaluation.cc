@@ -48,75 +48,51 @@ Status AddPlainEdgeBaselines(const ModelBundle& bundle, const Sample& s, const F
   return Status::Ok();
 }
 
-// The detector's own path, timed: enhanced edges, BP = OAOCC+OLP@4+MS, regression, fusion and
-// the paper's map. Kept for the other variants: the edges, the multistride regions' boxes and
-// the regressed BP.
+// The detector's own path, as Detect composes it: enhanced edges, BP = OAOCC+OLP@4+MS,
+// regression, fusion and the paper's map, timed stage by stage. Its trace (the edges, the
+// regions' boxes, the regressed BP, the fused boxes and the map) feeds the other variants.
 struct DetectorPath {
-  OcclusionEdges oaocc;
-  std::vector<RegionProposals> ms_regions;
-  RegressedProposals regressed;
-  std::vector<ScoredBox> fusion;  // BP's boxes with their fused scores
-  MapAccumulation fusion_boxes;
-  cv::Mat1f fusion_map;
+  FrameTrace trace;
+  Detection detection;
 };
 
-Result<DetectorPath> RunDetectorPath(const ModelBundle& bundle, const Sample& s,
-                                     const FrameGeometry& geo, StageTimer& timer,
+Result<DetectorPath> RunDetectorPath(const ObstacleDetector& detector, const Sample& s,
                                      FrameEvaluation& out) {
   DetectorPath path;
-  Result<OcclusionEdges> computed =
-      ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion,
-                            OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows),
-                            bundle.params, /*enhance=*/true, &timer);
-  if (!computed.ok()) return computed.status();
-  path.oaocc = std::move(computed).value();
-  const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
-  for (int k = 0; k < geo.regions.num_layers(); ++k)
-    path.ms_regions.push_back(
-        ProposeRegionBoxes(path.oaocc, geo.regions, bundle.params.boxes, k, true, filter));
-  ProposalSet bp = MergeRegionBoxes(path.ms_regions, bundle.params.region_merge_iou);
-  timer.Mark("proposals");
-  out.ranked["OAOCC+OLP@4+MS"] = RankedOnCommonScale(bp);
-  path.regressed =
-      RegressProposals(bundle, s.image, path.oaocc, geo.regions, std::move(bp), &timer);
-  path.fusion = ScoredWith(
-      path.regressed, FuseScores(path.regressed.ordr, path.regressed.obdr, bundle.params.fusion));
-  path.fusion_boxes = AccumulatedBoxes(path.fusion, bundle.params.probability_map);
-  const MapSuperpixels superpixels{path.oaocc.superpixels, path.oaocc.r1};
-  Result<cv::Mat1f> painted =
-      PaintProbabilityMap(path.fusion_boxes, s.image.size(),
-                          bundle.params.probability_map.superpixel_shares, &superpixels);
-  if (!painted.ok()) return painted.status();
-  path.fusion_map = std::move(painted).value();
-  timer.Mark("probability_map");
+  // The defaults `tod detect` reports obstacles at; every proposal feeds the map either way.
+  Result<Detection> detected = detector.Detect(s.image, DetectOptions{}, &path.trace);
+  if (!detected.ok()) return detected.status();
+  path.detection = std::move(detected).value();
+  out.ranked["OAOCC+OLP@4+MS"] = RankedOnCommonScale(path.trace.regressed.proposals);
   return path;
 }
 
 // OAOCC+OLP@1 (R1's boxes, whose stride factor is 1 with and without MS) and OAOCC+OLP@4 (OP:
 // R2..RK scored again without MS), with OP regressed by ORDR.
 Result<std::vector<ScoredBox>> AddSingleStrideVariants(const ModelBundle& bundle, const Sample& s,
-                                                       const FrameGeometry& geo,
-                                                       const DetectorPath& path,
+                                                       const FrameTrace& trace,
                                                        FrameEvaluation& out) {
-  out.ranked["OAOCC+OLP@1"] = BoxesOf(path.ms_regions.front().boxes);
+  const std::vector<RegionProposals>& ms_regions = trace.regions.per_region;
+  const FrameGeometry& geo = trace.geometry;
+  out.ranked["OAOCC+OLP@1"] = BoxesOf(ms_regions.front().boxes);
   const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
-  std::vector<RegionProposals> plain_regions = {path.ms_regions.front()};
+  std::vector<RegionProposals> plain_regions = {ms_regions.front()};
   for (int k = 1; k < geo.regions.num_layers(); ++k)
     plain_regions.push_back(
-        ProposeRegionBoxes(path.oaocc, geo.regions, bundle.params.boxes, k, false, filter));
+        ProposeRegionBoxes(trace.oaocc, geo.regions, bundle.params.boxes, k, false, filter));
   ProposalSet op = MergeRegionBoxes(plain_regions, bundle.params.region_merge_iou);
   out.ranked["OAOCC+OLP@4"] = RankedOnCommonScale(op);
   const RegressedProposals op_regressed =
-      RegressProposals(bundle, s.image, path.oaocc, geo.regions, std::move(op));
+      RegressProposals(bundle, s.image, trace.oaocc, geo.regions, std::move(op));
   return ScoredWith(op_regressed, op_regressed.ordr);
 }
 
 // The regression variants' maps (and the calibrated map when the bundle has one) and their
 // ranked boxes above the map's minimum score.
-Status AddRegressionVariants(const ModelBundle& bundle, const Sample& s, const DetectorPath& path,
+Status AddRegressionVariants(const ModelBundle& bundle, const Sample& s, const FrameTrace& trace,
                              const std::vector<ScoredBox>& op_ordr, FrameEvaluation& out) {
-  const std::vector<ScoredBox> bp_ordr = ScoredWith(path.regressed, path.regressed.ordr);
-  const MapSuperpixels superpixels{path.oaocc.superpixels, path.oaocc.r1};
+  const std::vector<ScoredBox> bp_ordr = ScoredWith(trace.regressed, trace.regressed.ordr);
+  const MapSuperpixels superpixels = trace.map_superpixels();
   Result<cv::Mat1f> bp_ordr_map = AccumulateProbabilityMap(
       bp_ordr, s.image.size(), bundle.params.probability_map, &superpixels);
   Result<cv::Mat1f> op_ordr_map = AccumulateProbabilityMap(
@@ -125,10 +101,10 @@ Status AddRegressionVariants(const ModelBundle& bundle, const Sample& s, const D
   if (!op_ordr_map.ok()) return op_ordr_map.status();
   out.maps.emplace_back("OP+ORDR@4", std::move(op_ordr_map).value());
   out.maps.emplace_back("BP+ORDR@4", std::move(bp_ordr_map).value());
-  out.maps.emplace_back("BP+Fusion@4", path.fusion_map);
+  out.maps.emplace_back("BP+Fusion@4", trace.served);
   if (bundle.params.obstacle_calibration.fitted) {
     Result<cv::Mat1f> calibrated =
-        ServedProbabilityMap(path.fusion, path.fusion_boxes, s.image.size(), path.oaocc,
+        ServedProbabilityMap(trace.fused, trace.accumulated, s.image.size(), trace.oaocc,
                              bundle.params, MapKind::kCalibrated);
     if (!calibrated.ok()) return calibrated.status();
     out.maps.emplace_back(kCalibratedMapVariant, std::move(calibrated).value());
@@ -136,20 +112,15 @@ Status AddRegressionVariants(const ModelBundle& bundle, const Sample& s, const D
   const float min_score = bundle.params.probability_map.min_score;
   out.ranked["OP+ORDR@4"] = BoxesOf(RankedAboveThreshold(op_ordr, min_score));
   out.ranked["BP+ORDR@4"] = BoxesOf(RankedAboveThreshold(bp_ordr, min_score));
-  out.ranked["BP+Fusion@4"] = BoxesOf(RankedAboveThreshold(path.fusion, min_score));
+  out.ranked["BP+Fusion@4"] = BoxesOf(RankedAboveThreshold(trace.fused, min_score));
   return Status::Ok();
 }
 
-// The obstacles the detector reports at its defaults (calibrated score >= 0.5), from the map it
-// takes them from: false alarms (no ground-truth obstacle pixel in the box) and the ground-truth
-// instances some reported box overlaps.
-Status CountReportedObstacles(const ModelBundle& bundle, const Sample& s, const DetectorPath& path,
-                              FrameEvaluation& out) {
-  Result<cv::Mat1f> components = ObstacleComponentsMap(
-      path.fusion_boxes, s.image.size(), bundle.params, MapKind::kNormalized, path.fusion_map);
-  if (!components.ok()) return components.status();
-  const std::vector<DetectedObstacle> reported =
-      ScoreObstacles(*components, path.fusion_boxes.boxes, bundle.params, DetectOptions{});
+// The obstacles the detector reports at its defaults (calibrated score >= 0.5): false alarms
+// (no ground-truth obstacle pixel in the box) and the ground-truth instances some reported box
+// overlaps.
+void CountReportedObstacles(const Sample& s, const std::vector<DetectedObstacle>& reported,
+                            FrameEvaluation& out) {
   for (const DetectedObstacle& o : reported)
     out.false_alarms += cv::countNonZero(s.obstacle(o.box.rect())) == 0;
   for (const ObstacleInstance& inst : s.instances)
@@ -158,24 +129,25 @@ Status CountReportedObstacles(const ModelBundle& bundle, const Sample& s, const 
         ++out.instances_found;
         break;
       }
-  return Status::Ok();
 }
 
 }  // namespace
 
-Result<FrameEvaluation> EvaluateFrame(const ModelBundle& bundle, const Sample& sample) {
+Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sample& sample) {
+  const ModelBundle& bundle = detector.bundle();
   const FrameGeometry geo = GeometryForFrame(bundle, sample.image.cols, sample.image.rows);
   FrameEvaluation out;
   if (Status st = AddPlainEdgeBaselines(bundle, sample, geo, out); !st.ok()) return st;
-  StageTimer timer;
-  Result<DetectorPath> path = RunDetectorPath(bundle, sample, geo, timer, out);
+  Result<DetectorPath> path = RunDetectorPath(detector, sample, out);
   if (!path.ok()) return path.status();
-  out.stage_times = timer.times();
-  out.total_ms = timer.total_ms();
-  Result<std::vector<ScoredBox>> op_ordr = AddSingleStrideVariants(bundle, sample, geo, *path, out);
+  out.stage_times = path->detection.timings;
+  out.total_ms = 0;
+  for (const auto& [stage, ms] : out.stage_times) out.total_ms += ms;
+  const FrameTrace& trace = path->trace;
+  Result<std::vector<ScoredBox>> op_ordr = AddSingleStrideVariants(bundle, sample, trace, out);
   if (!op_ordr.ok()) return op_ordr.status();
-  if (Status st = AddRegressionVariants(bundle, sample, *path, *op_ordr, out); !st.ok()) return st;
-  if (Status st = CountReportedObstacles(bundle, sample, *path, out); !st.ok()) return st;
+  if (Status st = AddRegressionVariants(bundle, sample, trace, *op_ordr, out); !st.ok()) return st;
+  CountReportedObstacles(sample, path->detection.obstacles, out);
   return out;
 }
 

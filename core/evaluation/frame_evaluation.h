@@ -13,7 +13,7 @@
 #include "core/base/stage_timer.h"
 #include "core/base/status.h"
 #include "core/base/types.h"
-#include "core/pipeline/model_bundle.h"
+#include "core/pipeline/obstacle_detector.h"
 
 namespace tod {
 
@@ -50,6 +50,8 @@ struct FrameEvaluation {
   double total_ms = 0;
 };
 
-Result<FrameEvaluation> EvaluateFrame(const ModelBundle& bundle, const Sample& sample);
+// The detector's own path comes from one Detect call (its FrameTrace); the baselines and the
+// paper's other variants are computed beside it from that trace.
+Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sample& sample);
 
 }  // namespace tod

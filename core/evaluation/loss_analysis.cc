@@ -112,43 +112,45 @@ Status ScoreAgainstObstacles(const ModelBundle& bundle, const Sample& s,
   return Status::Ok();
 }
 
-Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
-                                 const LossAnalysisOptions& options) {
-  FrameResult out;
-  const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
-  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-      s.image, geo.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), bundle.params,
-      /*enhance=*/true);
-  if (!computed.ok()) return computed.status();
-  const OcclusionEdges& oaocc = *computed;
-  const int layers = geo.regions.num_layers();
+// Every region's boxes without the size filter (the variant that shows what the filter drops),
+// on the detector's own edges; with windows_scored the detector's (filtered) scan's count.
+std::vector<ScoredBox> UnfilteredBoxes(const ModelBundle& bundle, const FrameTrace& trace) {
   std::vector<ScoredBox> unfiltered;
-  std::vector<RegionProposals> filtered(layers);
-  const SizeFilter* filter = bundle.params.size_filter ? &geo.size_filter : nullptr;
-  long long windows_scored = 0;  // as the detector scores them (size filter admission on)
+  const int layers = trace.geometry.regions.num_layers();
   for (int k = 0; k < layers; ++k) {
-    EdgeBoxStats unfiltered_stats, stats;
-    const auto all = ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k,
-                                        bundle.params.multistride, nullptr, &unfiltered_stats);
+    const RegionProposals all =
+        ProposeRegionBoxes(trace.oaocc, trace.geometry.regions, bundle.params.boxes, k,
+                           bundle.params.multistride, nullptr);
     unfiltered.insert(unfiltered.end(), all.boxes.begin(), all.boxes.end());
-    filtered[k] = filter ? ProposeRegionBoxes(oaocc, geo.regions, bundle.params.boxes, k,
-                                              bundle.params.multistride, filter, &stats)
-                         : all;
-    windows_scored += (filter ? stats : unfiltered_stats).windows_visited;
   }
-  ProposalSet merged = MergeRegionBoxes(filtered, bundle.params.region_merge_iou);
-  const std::vector<Box> by_objectness = RankedOnCommonScale(merged);
-  const RegressedProposals reg =
-      RegressProposals(bundle, s.image, oaocc, geo.regions, std::move(merged));
-  const std::vector<float> fused = FuseScores(reg.ordr, reg.obdr, bundle.params.fusion);
+  return unfiltered;
+}
+
+Result<FrameResult> AnalyseFrame(const ObstacleDetector& detector, const Sample& s,
+                                 const LossAnalysisOptions& options) {
+  const ModelBundle& bundle = detector.bundle();
+  FrameResult out;
+  FrameTrace trace;
+  const Result<Detection> detected = detector.Detect(s.image, DetectOptions{}, &trace);
+  if (!detected.ok()) return detected.status();
+  const OcclusionEdges& oaocc = trace.oaocc;
+  const FrameGeometry& geo = trace.geometry;
+  const std::vector<RegionProposals>& filtered = trace.regions.per_region;
+  const std::vector<ScoredBox> unfiltered =
+      bundle.params.size_filter ? UnfilteredBoxes(bundle, trace) : std::vector<ScoredBox>{};
+  long long windows_scored = 0;  // as the detector scores them (size filter admission on)
+  for (const EdgeBoxStats& stats : trace.regions.stats) windows_scored += stats.windows_visited;
+  const RegressedProposals& reg = trace.regressed;
+  const std::vector<Box> by_objectness = RankedOnCommonScale(reg.proposals);
+  std::vector<float> fused(trace.fused.size());
+  for (std::size_t i = 0; i < fused.size(); ++i) fused[i] = trace.fused[i].score;
   std::vector<int> order(fused.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return fused[a] > fused[b]; });
   std::vector<Box> by_fused;
   for (int i : order) by_fused.push_back(reg.proposals.boxes[i].box);
-  if (Status st = ScoreAgainstObstacles(bundle, s, {oaocc.superpixels, oaocc.r1},
-                                        reg.proposals.boxes, fused, out);
+  if (Status st = ScoreAgainstObstacles(bundle, s, trace.map_superpixels(), reg.proposals.boxes,
+                                        fused, out);
       !st.ok())
     return st;
 
@@ -171,11 +173,13 @@ Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
     f.in_r1 = Intersect(inst.box, oaocc.r1) == inst.box;
     f.contour_base_edges = ContourCoverage(inst, base_near, oaocc.r1);
     f.contour_occlusion = ContourCoverage(inst, occlusion_near, oaocc.r1);
-    f.best_iou_unfiltered = BestIoU(unfiltered, inst.box);
     double best_filtered = 0;
     for (const auto& region_boxes : filtered)
       best_filtered = std::max(best_filtered, BestIoU(region_boxes.boxes, inst.box));
     f.best_iou_filtered = best_filtered;
+    // Without a size filter the detector's own boxes are the unfiltered ones.
+    f.best_iou_unfiltered =
+        bundle.params.size_filter ? BestIoU(unfiltered, inst.box) : best_filtered;
     f.proposal_rank = FirstHit(by_objectness, inst.box, options.hit_iou, options.top_n);
     f.regressed_rank = FirstHit(by_fused, inst.box, options.hit_iou, options.top_n);
     out.fates.push_back(f);
@@ -220,13 +224,14 @@ Result<LossAnalysis> AnalyseLosses(const ModelBundle& bundle, const LossAnalysis
   if (!selection.ok()) return selection.status();
   const int n = static_cast<int>(selection->frames.size());
   std::vector<FrameResult> results(n);
+  const ObstacleDetector detector(bundle, "analyse");  // one copy of the bundle for the run
   std::array<PixelHistogramAccumulator, kApScorings> pixels;
   std::mutex mutex;
   int done = 0;
   const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
     auto sample = selection->dataset->Load(selection->frames[i]);
     if (!sample.ok()) return sample.status();
-    Result<FrameResult> result = AnalyseFrame(bundle, *sample, options);
+    Result<FrameResult> result = AnalyseFrame(detector, *sample, options);
     if (!result.ok()) return result.status();
     results[i] = std::move(result).value();
     std::lock_guard lock(mutex);

@@ -8,7 +8,6 @@
 #include "core/base/atomic_file.h"
 #include "core/pipeline/detection_output.h"
 #include "core/pipeline/frame_stages.h"
-#include "core/pipeline/obstacle_detector.h"
 
 namespace tod {
 namespace {
@@ -138,25 +137,17 @@ cv::Mat3b DrawProposals(const cv::Mat3b& bgr, const MultilayerRegions& regions, 
 
 }  // namespace
 
-Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b& bgr,
+Result<StageImages> RenderStageImages(const FrameTrace& trace, const cv::Mat3b& bgr,
                                       const StageImageOptions& options) {
-  if (bgr.cols < 16 || bgr.rows < 16)
-    return Status::InvalidArgument(
-        "image too small for the stage images: " + std::to_string(bgr.cols) + "x" +
-        std::to_string(bgr.rows) + " (at least 16x16)");
-  const FrameGeometry geometry = GeometryForFrame(bundle, bgr.cols, bgr.rows);
-  const MultilayerRegions& regions = geometry.regions;
+  const MultilayerRegions& regions = trace.geometry.regions;
   const int layers = regions.num_layers();
   if (layers == 0 || ClipToImage(regions.layers.front(), bgr.cols, bgr.rows).empty())
     return Status::InvalidArgument("the bundle's R1 does not cover the frame");
-  // The detector's own stage calls (ObstacleDetector::Detect).
-  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-      bgr, regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, bgr.cols, bgr.rows), bundle.params,
-      /*enhance=*/true);
-  if (!computed.ok()) return computed.status();
-  const OcclusionEdges& oaocc = *computed;
-  const SizeFilter* size_filter = bundle.params.size_filter ? &geometry.size_filter : nullptr;
+  const OcclusionEdges& oaocc = trace.oaocc;
+  const std::vector<RegionProposals>& per_region = trace.regions.per_region;
+  if (per_region.size() != static_cast<std::size_t>(layers) ||
+      trace.regions.stats.size() != per_region.size())
+    return Status::InvalidArgument("the trace has no proposals of every region");
 
   StageImages out;
   const cv::Size frame = bgr.size();
@@ -178,12 +169,9 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
   counts["superpixels"] = oaocc.superpixels.count;
   counts["occlusion_edge_pixels"] = CountAbove(oaocc.occlusion, options.edge_threshold);
   counts["regions"] = nlohmann::json::array();
-  std::vector<RegionProposals> per_region;
   for (int k = 0; k < layers; ++k) {
-    EdgeBoxStats stats;
-    RegionProposals proposals = ProposeRegionBoxes(oaocc, regions, bundle.params.boxes, k,
-                                                   bundle.params.multistride, size_filter, &stats);
-    const std::vector<ScoredBox>& boxes = proposals.boxes;
+    const EdgeBoxStats& stats = trace.regions.stats[k];
+    const std::vector<ScoredBox>& boxes = per_region[k].boxes;
     const int drawn =
         std::min(std::max(0, options.proposals_drawn), static_cast<int>(boxes.size()));
     out.images.push_back(
@@ -200,11 +188,9 @@ Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b
     region["proposals_kept"] = boxes.size();
     region["proposals_drawn"] = drawn;
     counts["regions"].push_back(std::move(region));
-    per_region.push_back(std::move(proposals));
   }
   // After the cross-region merge, as the detector regresses them.
-  counts["proposals_total"] =
-      MergeRegionBoxes(per_region, bundle.params.region_merge_iou).boxes.size();
+  counts["proposals_total"] = trace.regressed.proposals.boxes.size() + trace.regressed.dropped;
   return out;
 }
 

@@ -1,8 +1,7 @@
 // `tod detect --stages`: the intermediate results of one frame as pictures and counts, so that a
-// person can see at which stage an obstacle is lost. The stages are run again here with the same
-// public stage functions, parameters and geometry the detector uses (GeometryForFrame,
-// ComputeOcclusionEdges with enhancement, ProposeRegionBoxes per region); they are deterministic,
-// so the pictures show exactly what the detection was made from.
+// person can see at which stage an obstacle is lost. They are drawn from the detection's own
+// FrameTrace (ObstacleDetector::Detect with a trace), so they show exactly what the detection was
+// made from, at the cost of the drawing alone.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -11,7 +10,7 @@
 #include <vector>
 
 #include "core/base/status.h"
-#include "core/pipeline/model_bundle.h"
+#include "core/pipeline/frame_trace.h"
 
 namespace tod {
 
@@ -53,8 +52,8 @@ struct StageImages {
   nlohmann::json counts;
 };
 
-// Needs a frame of at least 16 x 16 pixels, as Detector::Detect does.
-Result<StageImages> RenderStageImages(const ModelBundle& bundle, const cv::Mat3b& bgr,
+// `trace` is what ObstacleDetector::Detect filled for `bgr`.
+Result<StageImages> RenderStageImages(const FrameTrace& trace, const cv::Mat3b& bgr,
                                       const StageImageOptions& options = {});
 
 // Writes base_path + "_stage_<name>.png" for each picture and base_path + "_stages.json", each

@@ -217,15 +217,13 @@ FrameRegionProposals ProposeRegions(const OcclusionEdges& oaocc, const Multilaye
       RegionWindowCounts(oaocc, regions, box_params, used, options.multistride);
   const SizeFilter* filter = options.size_filter ? &size_filter : nullptr;
   std::vector<RegionProposals> per_region(used);
-  std::vector<char> truncated(used, 0);
+  std::vector<EdgeBoxStats> region_stats(used);
   const auto propose = [&](int k, Clock::time_point deadline) {
     EdgeBoxParams params = box_params;
     params.threads = options.threads;
     params.deadline = deadline;
-    EdgeBoxStats stats;
-    per_region[k] =
-        ProposeRegionBoxes(oaocc, regions, params, k, options.multistride, filter, &stats);
-    truncated[k] = stats.truncated;
+    per_region[k] = ProposeRegionBoxes(oaocc, regions, params, k, options.multistride, filter,
+                                       &region_stats[k]);
   };
   // Several threads: up to that many regions run side by side, each scanned with all of them.
   // A region's own work (its edge groups, the selection of windows to refine, its NMS) is serial,
@@ -257,7 +255,8 @@ FrameRegionProposals ProposeRegions(const OcclusionEdges& oaocc, const Multilaye
   FrameRegionProposals out;
   out.per_region = std::move(per_region);
   for (int k = 0; k < used; ++k)
-    if (truncated[k]) out.truncated_regions.push_back(k);
+    if (region_stats[k].truncated) out.truncated_regions.push_back(k);
+  out.stats = std::move(region_stats);
   return out;
 }
 
@@ -268,9 +267,9 @@ ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& r
                            options.merge_iou);
 }
 
-ProposalSet MergeFrameRegions(FrameRegionProposals found, float merge_iou) {
+ProposalSet MergeFrameRegions(const FrameRegionProposals& found, float merge_iou) {
   ProposalSet out = MergeRegionBoxes(found.per_region, merge_iou);
-  out.truncated_regions = std::move(found.truncated_regions);
+  out.truncated_regions = found.truncated_regions;
   return out;
 }
 

@@ -122,13 +122,14 @@ std::vector<Box> RankedOnCommonScale(const ProposalSet& proposals);
 struct FrameRegionProposals {
   std::vector<RegionProposals> per_region;  // index = region
   std::vector<int> truncated_regions;       // as ProposalSet's
+  std::vector<EdgeBoxStats> stats;          // index = region: its scan's counters
 };
 FrameRegionProposals ProposeRegions(const OcclusionEdges& oaocc, const MultilayerRegions& regions,
                                     const EdgeBoxParams& box_params, const ProposalOptions& options,
                                     const SizeFilter& size_filter);
 
 // MergeRegionBoxes of the frame's regions, with their truncated_regions.
-ProposalSet MergeFrameRegions(FrameRegionProposals found, float merge_iou);
+ProposalSet MergeFrameRegions(const FrameRegionProposals& found, float merge_iou);
 
 // ProposeRegions, then MergeFrameRegions.
 ProposalSet ProposeBoxes(const OcclusionEdges& oaocc, const MultilayerRegions& regions,

@@ -122,11 +122,11 @@ Status CheckRequest(const cv::Mat3b& bgr, const DetectOptions& options,
 
 // The `max_proposals` best proposals by fused score (ties: by ORDR, then list order).
 std::vector<Proposal> BestProposals(const RegressedProposals& regressed,
-                                    const std::vector<float>& fused, int max_proposals) {
+                                    const std::vector<ScoredBox>& fused, int max_proposals) {
   std::vector<std::size_t> order(fused.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    if (fused[a] != fused[b]) return fused[a] > fused[b];
+    if (fused[a].score != fused[b].score) return fused[a].score > fused[b].score;
     return regressed.ordr[a] > regressed.ordr[b];
   });
   const std::size_t n = std::min<std::size_t>(order.size(), std::max(0, max_proposals));
@@ -134,8 +134,7 @@ std::vector<Proposal> BestProposals(const RegressedProposals& regressed,
   best.reserve(n);
   for (std::size_t r = 0; r < n; ++r) {
     const std::size_t i = order[r];
-    best.push_back(
-        {regressed.proposals.boxes[i].box, fused[i], regressed.ordr[i], regressed.obdr[i]});
+    best.push_back({fused[i].box, fused[i].score, regressed.ordr[i], regressed.obdr[i]});
   }
   return best;
 }
@@ -148,38 +147,44 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr,
 }
 
 Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOptions& options,
-                                           MapSuperpixels* superpixels) const {
+                                           FrameTrace* trace) const {
+  FrameTrace local;  // the stages' results; handed to the caller when it asks for them
+  FrameTrace& frame = trace != nullptr ? *trace : local;
+  frame = FrameTrace{};
   if (Status st = CheckRequest(bgr, options, bundle_.params); !st.ok()) return st;
   StageTimer timer(options.cancelled);  // asks options.cancelled at every stage boundary
   const FrameBudget budget(std::chrono::steady_clock::now(), options.budget_ms);
   const int threads = std::max(1, options.threads);
-  const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
-  const Result<OcclusionEdges> computed =
-      ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges, &bundle_.occlusion,
+  frame.geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
+  const MultilayerRegions& regions = frame.geometry.regions;
+  Result<OcclusionEdges> computed =
+      ComputeOcclusionEdges(bgr, regions, *bundle_.edges, &bundle_.occlusion,
                             OcclusionFeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows),
                             bundle_.params, /*enhance=*/true, &timer, &budget);
   if (!computed.ok()) return computed.status();
   if (!timer.stopped().ok()) return timer.stopped();
-  const OcclusionEdges& oaocc = *computed;
+  frame.oaocc = std::move(computed).value();
+  const OcclusionEdges& oaocc = frame.oaocc;
   // E and Ê are not read after this point, but they stay until the frame ends: released here
   // they left a hole the proposal stage's larger tables could not use, and the process's peak
   // RSS over 20 real frames rose 190 -> 199 MB although the live heap's peak fell.
-  ProposalOptions proposal_options =
-      DetectorProposalOptions(bundle_.params, geometry.regions.num_layers());
+  ProposalOptions proposal_options = DetectorProposalOptions(bundle_.params, regions.num_layers());
   proposal_options.deadline = budget.ProposalsDeadline();
   proposal_options.threads = threads;
-  FrameRegionProposals found = ProposeRegions(oaocc, geometry.regions, bundle_.params.boxes,
-                                              proposal_options, geometry.size_filter);
+  frame.regions = ProposeRegions(oaocc, regions, bundle_.params.boxes, proposal_options,
+                                 frame.geometry.size_filter);
   // The regions' merge is one thread's work (a greedy NMS over some 30 000 boxes). R1's colour
   // tables for the features read the image alone, so a second thread builds them meanwhile; one
   // thread builds them at the features stage. Either way the same tables. (Started with the
   // frame or after the edges, the tables slowed the stages they ran beside, whose stripes and
-  // chained sweeps wait for their slowest thread; README, Speed.)
+  // chained sweeps wait for their slowest thread; docs/findings.md.)
   ProposalSet proposals;
   FrameColourTables colour_tables;
   const auto merge_or_tables = [&](int task) {
     if (task == 0) {
-      proposals = MergeFrameRegions(std::move(found), proposal_options.merge_iou);
+      proposals = MergeFrameRegions(frame.regions, proposal_options.merge_iou);
+      // The regions' own boxes are freed with the merge unless the caller keeps them.
+      if (trace == nullptr) frame.regions = {};
     } else {
       colour_tables = BuildFrameColourTables(bgr, oaocc.r1,
                                              FeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows));
@@ -193,33 +198,40 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   Detection out;
   if (oaocc.occlusion_cut_short) out.degraded_stages.push_back("occlusion");
   if (!proposals.truncated_regions.empty()) out.degraded_stages.push_back("proposals");
-  RegressedProposals regressed = RegressProposals(
-      bundle_, bgr, oaocc, geometry.regions, std::move(proposals), &timer,
-      {.deadline = budget.RegressionDeadline(), .threads = threads}, std::move(colour_tables));
+  frame.regressed = RegressProposals(bundle_, bgr, oaocc, regions, std::move(proposals), &timer,
+                                     {.deadline = budget.RegressionDeadline(), .threads = threads},
+                                     std::move(colour_tables));
   if (!timer.stopped().ok()) return timer.stopped();
-  if (regressed.truncated) out.degraded_stages.push_back("regression");
-  const std::vector<float> fused =
-      FuseScores(regressed.ordr, regressed.obdr, bundle_.params.fusion);
-
-  std::vector<ScoredBox> scored(fused.size());
-  for (std::size_t i = 0; i < fused.size(); ++i)
-    scored[i] = {regressed.proposals.boxes[i].box, fused[i]};
-  const MapAccumulation accumulated = AccumulatedBoxes(scored, bundle_.params.probability_map);
-  Result<FrameMaps> maps = PaintFrameMaps(scored, accumulated, bgr.size(), oaocc, bundle_.params,
-                                          options.map_kind, threads);
-  if (!maps.ok()) return maps.status();
+  if (frame.regressed.truncated) out.degraded_stages.push_back("regression");
+  if (Status st = PaintMaps(bgr.size(), options, threads, frame); !st.ok()) return st;
   out.map_kind = options.map_kind;
   out.width = bgr.cols;
   out.height = bgr.rows;
-  const cv::Mat1f& components = maps->components.empty() ? maps->served : maps->components;
-  out.obstacles = ScoreObstacles(components, accumulated.boxes, bundle_.params, options);
+  out.obstacles =
+      ScoreObstacles(frame.components, frame.accumulated.boxes, bundle_.params, options);
   timer.Mark("probability_map");
 
-  out.proposals = BestProposals(regressed, fused, options.max_proposals);
-  if (options.want_probability_map) out.probability = std::move(maps->served);
-  if (superpixels != nullptr) *superpixels = {oaocc.superpixels, oaocc.r1};
+  out.proposals = BestProposals(frame.regressed, frame.fused, options.max_proposals);
+  if (options.want_probability_map) out.probability = frame.served;
   out.timings = timer.times();
   return out;
+}
+
+Status ObstacleDetector::PaintMaps(cv::Size image_size, const DetectOptions& options, int threads,
+                                   FrameTrace& frame) const {
+  const RegressedProposals& regressed = frame.regressed;
+  const std::vector<float> fused =
+      FuseScores(regressed.ordr, regressed.obdr, bundle_.params.fusion);
+  frame.fused.resize(fused.size());
+  for (std::size_t i = 0; i < fused.size(); ++i)
+    frame.fused[i] = {regressed.proposals.boxes[i].box, fused[i]};
+  frame.accumulated = AccumulatedBoxes(frame.fused, bundle_.params.probability_map);
+  Result<FrameMaps> maps = PaintFrameMaps(frame.fused, frame.accumulated, image_size, frame.oaocc,
+                                          bundle_.params, options.map_kind, threads);
+  if (!maps.ok()) return maps.status();
+  frame.served = std::move(maps->served);
+  frame.components = maps->components.empty() ? frame.served : std::move(maps->components);
+  return Status::Ok();
 }
 
 Result<std::shared_ptr<const Detector>> Detector::Load(const std::string& model_dir) {

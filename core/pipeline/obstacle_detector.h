@@ -6,6 +6,7 @@
 #include "core/pipeline/detector.h"
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
+#include "core/pipeline/frame_trace.h"
 #include "core/pipeline/model_bundle.h"
 #include "core/pipeline/proposal_regression.h"
 
@@ -44,14 +45,18 @@ class ObstacleDetector final : public Detector {
  public:
   ObstacleDetector(ModelBundle bundle, std::string name);
   Result<Detection> Detect(const cv::Mat3b& bgr, const DetectOptions& options) const override;
-  // Detect, also handing back the frame's superpixels, with which a caller rebuilds the map
-  // under other parameters (the trainer's isolation fit). `superpixels` may be null.
+  // Detect, also handing back what the stages computed (frame_trace.h) in `trace` (may be null;
+  // overwritten). The stages run once either way; on an error the trace holds the stages done.
   Result<Detection> Detect(const cv::Mat3b& bgr, const DetectOptions& options,
-                           MapSuperpixels* superpixels) const;
+                           FrameTrace* trace) const;
   const ModelInfo& info() const override { return info_; }
   const ModelBundle& bundle() const { return bundle_; }
 
  private:
+  // Fusion (§6), the map's boxes and the maps (§7) of frame.regressed, into `frame`.
+  Status PaintMaps(cv::Size image_size, const DetectOptions& options, int threads,
+                   FrameTrace& frame) const;
+
   ModelBundle bundle_;
   ModelInfo info_;
 };

@@ -35,13 +35,13 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
     options.max_proposals = std::numeric_limits<int>::max();  // the map's input: every box
     options.want_probability_map = false;
     const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
-      MapSuperpixels superpixels;
-      auto detection = detector.Detect(s.image, options, &superpixels);
+      FrameTrace trace;
+      auto detection = detector.Detect(s.image, options, &trace);
       if (!detection.ok()) return detection.status();
       std::vector<ScoredBox> fused;
       fused.reserve(detection->proposals.size());
       for (const Proposal& p : detection->proposals) fused.push_back({p.box, p.fused});
-      return isolation.AddFrame(i, s, superpixels, fused);
+      return isolation.AddFrame(i, s, trace.map_superpixels(), fused);
     }));
     if (!st.ok()) return st.WithContext("calibrating obstacle scores");
   }

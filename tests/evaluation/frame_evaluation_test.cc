@@ -30,9 +30,9 @@ Sample RoadSample(int width, int height) {
 }
 
 TEST(FrameEvaluation, GivesEveryVariantAndTimesTheDetectorsPathOnly) {
-  const ModelBundle bundle = TinyBundle();
+  const ObstacleDetector detector(TinyBundle(), "tiny");
   const Sample sample = RoadSample(512, 256);
-  const Result<FrameEvaluation> frame = EvaluateFrame(bundle, sample);
+  const Result<FrameEvaluation> frame = EvaluateFrame(detector, sample);
   ASSERT_TRUE(frame.ok()) << frame.status().ToString();
 
   std::set<std::string> expected(ProposalVariants().begin(), ProposalVariants().end());
@@ -62,11 +62,10 @@ TEST(FrameEvaluation, GivesEveryVariantAndTimesTheDetectorsPathOnly) {
 }
 
 TEST(FrameEvaluation, FusionMapIsTheMapDetectServes) {
-  const ModelBundle bundle = TinyBundle();
-  const Sample sample = RoadSample(512, 256);
-  const Result<FrameEvaluation> frame = EvaluateFrame(bundle, sample);
-  ASSERT_TRUE(frame.ok()) << frame.status().ToString();
   const ObstacleDetector detector(TinyBundle(), "tiny");
+  const Sample sample = RoadSample(512, 256);
+  const Result<FrameEvaluation> frame = EvaluateFrame(detector, sample);
+  ASSERT_TRUE(frame.ok()) << frame.status().ToString();
   const Result<Detection> detected = detector.Detect(sample.image, DetectOptions{});
   ASSERT_TRUE(detected.ok()) << detected.status().ToString();
   const cv::Mat1f* fusion = nullptr;

@@ -28,12 +28,22 @@ const cv::Mat& Picture(const StageImages& stages, const std::string& name) {
   return kNone;
 }
 
+// The pictures as `tod detect --stages` makes them: from the detection's own trace.
+Result<StageImages> Render(const ModelBundle& bundle, const cv::Mat3b& frame,
+                           const StageImageOptions& options = {}) {
+  const ObstacleDetector detector(bundle, "tiny");
+  FrameTrace trace;
+  const Result<Detection> detection = detector.Detect(frame, DetectOptions{}, &trace);
+  if (!detection.ok()) return detection.status();
+  return RenderStageImages(trace, frame, options);
+}
+
 class StageImagesTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     bundle_ = new ModelBundle(TinyBundle());
     frame_ = new cv::Mat3b(RoadFrame(512, 256));
-    auto stages = RenderStageImages(*bundle_, *frame_);
+    auto stages = Render(*bundle_, *frame_);
     ASSERT_TRUE(stages.ok()) << stages.status().ToString();
     stages_ = new StageImages(std::move(*stages));
   }
@@ -140,7 +150,7 @@ TEST_F(StageImagesTest, CountsDescribeEveryStageAndAddUpToTheDetectorsProposals)
 TEST_F(StageImagesTest, ProposalPicturesDrawAtMostTheRequestedNumber) {
   StageImageOptions options;
   options.proposals_drawn = 3;
-  auto stages = RenderStageImages(*bundle_, *frame_, options);
+  auto stages = Render(*bundle_, *frame_, options);
   ASSERT_TRUE(stages.ok());
   for (const nlohmann::json& r : stages->counts["regions"])
     EXPECT_EQ(r["proposals_drawn"].get<long long>(),
@@ -150,11 +160,11 @@ TEST_F(StageImagesTest, ProposalPicturesDrawAtMostTheRequestedNumber) {
 TEST(StageImagesFrameTest, AnyFrameSizeGivesPicturesOfThatSizeAndTinyFramesAreRefused) {
   const ModelBundle bundle = TinyBundle();
   const cv::Mat3b frame = RoadFrame(301, 157);
-  auto stages = RenderStageImages(bundle, frame);
+  auto stages = Render(bundle, frame);
   ASSERT_TRUE(stages.ok()) << stages.status().ToString();
   for (const StageImage& image : stages->images)
     EXPECT_EQ(image.pixels.size(), frame.size()) << image.name;
-  auto tiny = RenderStageImages(bundle, cv::Mat3b(10, 10, cv::Vec3b(0, 0, 0)));
+  auto tiny = Render(bundle, cv::Mat3b(10, 10, cv::Vec3b(0, 0, 0)));
   ASSERT_FALSE(tiny.ok());
   EXPECT_NE(tiny.status().message().find("10x10"), std::string::npos);
 }
