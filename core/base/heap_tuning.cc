@@ -36,6 +36,12 @@ bool ShareOneHeapArena() {
 #endif
 }
 
+void ReleaseFreeHeapPages() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
+
 bool HeapArenaShared() { return heap_arena_shared; }
 
 }  // namespace tod

@@ -22,6 +22,15 @@ bool RetainLargeAllocations();
 // Call once, early in main(), before any thread starts.
 bool ShareOneHeapArena();
 
+// Hands the heap's free pages back to the kernel (glibc's malloc_trim), keeping the address
+// space. For a loop that keeps a little of every frame (the trainer's sampled rows): with
+// RetainLargeAllocations the frames' freed tables stay resident, and how well the next frame
+// reuses them depends on where the kept blocks fell, which shifts with anything that moves the
+// heap's layout (the dataset path's length did): the same 96-frame training peaked at 90 MB or
+// at 127-203 MB. Released after each frame, the peak is one frame's working set plus what is
+// kept, wherever the blocks fall. Costs the next frame's first touch of those pages.
+void ReleaseFreeHeapPages();
+
 // Whether ShareOneHeapArena succeeded in this process (what a benchmark reports beside its RSS).
 bool HeapArenaShared();
 

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "core/base/heap_tuning.h"
 #include "core/base/memory_usage.h"
 #include "core/pipeline/parallel.h"
 
@@ -30,9 +31,13 @@ void TrainingRun::Say(const std::string& line) {
 std::vector<Status> TrainingRun::ForEachFrame(
     const std::vector<int>& which, const std::function<Status(int, const Sample&)>& body) {
   return ParallelFor(static_cast<int>(which.size()), options_.threads, [&](int j) -> Status {
-    auto sample = selection_.dataset->Load(frames_[which[j]]);
-    if (!sample.ok()) return sample.status();
-    return body(which[j], *sample);
+    Status st = [&] {
+      auto sample = selection_.dataset->Load(frames_[which[j]]);
+      if (!sample.ok()) return sample.status();
+      return body(which[j], *sample);
+    }();
+    ReleaseFreeHeapPages();  // the frame's tables are freed; what the body kept stays
+    return st;
   });
 }
 
