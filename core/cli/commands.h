@@ -15,6 +15,7 @@ Runner AddDetectCommand(CLI::App& app);
 Runner AddEvalCommand(CLI::App& app);
 Runner AddAnalyseCommand(CLI::App& app);
 Runner AddBenchCommand(CLI::App& app);
+Runner AddCvCommand(CLI::App& app);
 
 // Prints "tod: <message>" to stderr and returns 1.
 int Fail(const std::string& message);

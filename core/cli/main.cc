@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   add(tod::cli::AddEvalCommand);
   add(tod::cli::AddAnalyseCommand);
   add(tod::cli::AddBenchCommand);
+  add(tod::cli::AddCvCommand);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
