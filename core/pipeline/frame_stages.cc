@@ -34,7 +34,7 @@ Result<OcclusionEdges> ComputeOcclusionEdges(
   OcclusionEdges out;
   out.r1 = ClipToImage(regions.layers.front(), image.cols, image.rows);
   out.crop = image(out.r1.rect());
-  out.base_edge = edges.Compute(out.crop, params.edge_screening);
+  out.base_edge = edges.Compute(out.crop);
   CorrectSampledPrior(out.base_edge, params.prior_correction.edge_odds);
   // §2.2 single pass: Ê(p) = n(p) E(p), n(p) = number of layers containing p. Each inner layer
   // adds the same map once more over its rectangle.

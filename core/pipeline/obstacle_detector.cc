@@ -97,12 +97,15 @@ ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
   info_.format_version = kBundleFormatVersion;
   info_.created = bundle_.created;
   info_.trained_on = TrainedOn(bundle_.training);
-  info_.edge_source = bundle_.edge_kind;
-  info_.manifest = {
-      {"version", bundle_.version},          {"created", bundle_.created},
-      {"edge_source", bundle_.edge_kind},    {"params", ToJson(bundle_.params)},
-      {"regions", bundle_.regions.ToJson()}, {"size_filter", bundle_.size_filter.ToJson()},
-      {"training", bundle_.training},        {"eval", bundle_.eval}};
+  info_.edge_source = std::string(EnumName(bundle_.edge_kind));
+  info_.manifest = {{"version", bundle_.version},
+                    {"created", bundle_.created},
+                    {"edge_source", std::string(EnumName(bundle_.edge_kind))},
+                    {"params", ToJson(bundle_.params)},
+                    {"regions", bundle_.regions.ToJson()},
+                    {"size_filter", bundle_.size_filter.ToJson()},
+                    {"training", bundle_.training},
+                    {"eval", bundle_.eval}};
 }
 
 namespace {

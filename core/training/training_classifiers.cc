@@ -6,13 +6,14 @@
 #include "core/edges/edge_labels.h"
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
+#include "core/training/trainer.h"
 
 namespace tod::training {
 namespace {
 
 constexpr char kFewFramesHint[] =
     "out-of-fold maps train each classifier again on each half of the classifier frames; with "
-    "few frames, --in-sample-maps trains without the halves";
+    "few frames, --paper out_of_fold_maps trains without the halves";
 
 // Trains the fold copies of a classifier (nothing when folds are off): fit(frames of fold f,
 // name) for each fold f, then install(upstream bundle of fold f, the copy).
@@ -45,28 +46,29 @@ std::vector<int> ClassifierFrames(const TrainingRun& run, const Survey& survey) 
     out.push_back(survey.usable[j]);
   return out;
 }
+
 // §3.4 step 1: the base edge source. Samples are extracted frame by frame.
 Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
                        ClassifierFolds& folds, nlohmann::json& parts) {
   const TrainOptions& options = run.options();
   bundle.edge_kind = options.edge_source;
-  if (options.edge_source == "gradient") {
-    bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
-    parts["edges"] = {{"kind", "gradient"}, {"learned", false}};
-    ShareUnlearnedEdges(bundle, folds);
-    return Status::Ok();
+  switch (options.edge_source) {
+    case EdgeKind::kGradient:
+      bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
+      parts["edges"] = {{"kind", "gradient"}, {"learned", false}};
+      ShareUnlearnedEdges(bundle, folds);
+      return Status::Ok();
+    case EdgeKind::kSed: {
+      auto sed = CreateSedEdgeSource(options.sed_model);
+      if (!sed.ok()) return sed.status().WithContext("loading the SED edge model");
+      bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
+      parts["edges"] = {{"kind", "sed"}, {"learned", false}, {"model", options.sed_model}};
+      ShareUnlearnedEdges(bundle, folds);
+      return Status::Ok();
+    }
+    case EdgeKind::kPixelForest:
+      break;  // trained below
   }
-  if (options.edge_source == "sed") {
-    auto sed = CreateSedEdgeSource(options.sed_model);
-    if (!sed.ok()) return sed.status().WithContext("loading the SED edge model");
-    bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
-    parts["edges"] = {{"kind", "sed"}, {"learned", false}, {"model", options.sed_model}};
-    ShareUnlearnedEdges(bundle, folds);
-    return Status::Ok();
-  }
-  if (options.edge_source != "pixel_forest")
-    return Status::InvalidArgument("unknown edge source '" + options.edge_source +
-                                   "' (pixel_forest, gradient, sed)");
   const std::vector<int> which = ClassifierFrames(run, survey);
   PixelEdgeParams edge_params = options.edge_params;
   edge_params.forest.seed = options.seed;
@@ -172,7 +174,7 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
                         {"frames", which.size()},
                         {"contour_pairs", positives},
                         {"edge_maps", folds.enabled ? "out_of_fold" : "in_sample"},
-                        {"fold_layout", FoldLayoutName(options.fold_layout)},
+                        {"fold_layout", kFoldLayoutName},
                         {"prior_odds", bundle.params.prior_correction.occlusion_odds},
                         {"trees", params.forest.num_trees},
                         {"negatives_per_positive", params.negatives_per_positive}};

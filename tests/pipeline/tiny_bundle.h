@@ -20,7 +20,7 @@ namespace tod {
 // regions and size filter) with tiny forests: enough to run every stage on a small frame.
 inline ModelBundle TinyBundle() {
   ModelBundle b;
-  b.edge_kind = "gradient";
+  b.edge_kind = EdgeKind::kGradient;
   b.edges = CreateGradientEdgeSource();
   b.regions = Laf2020Regions();
   b.size_filter = SizeFilter::Laf2020();
