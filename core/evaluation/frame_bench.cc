@@ -47,8 +47,7 @@ std::string ContractName(const std::string& detector_stage) {
 Status CountWork(const ModelBundle& bundle, const cv::Mat3b& bgr, FrameBenchRecord& record) {
   const FrameGeometry geometry = GeometryForFrame(bundle, bgr.cols, bgr.rows);
   const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-      bgr, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, bgr.cols, bgr.rows), bundle.params, /*enhance=*/true);
+      bgr, geometry.regions, *bundle.edges, &bundle.occlusion, bundle.params, /*enhance=*/true);
   if (!computed.ok()) return computed.status().WithContext("counting the work");
   const OcclusionEdges& oaocc = *computed;
   const SizeFilter* size_filter = bundle.params.size_filter ? &geometry.size_filter : nullptr;

@@ -116,10 +116,9 @@ Result<FrameResult> AnalyseFrame(const ModelBundle& bundle, const Sample& s,
                                  const LossAnalysisOptions& options) {
   FrameResult out;
   const FrameGeometry geo = GeometryForFrame(bundle, s.image.cols, s.image.rows);
-  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-      s.image, geo.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), bundle.params,
-      /*enhance=*/true);
+  const Result<OcclusionEdges> computed =
+      ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &bundle.occlusion, bundle.params,
+                            /*enhance=*/true);
   if (!computed.ok()) return computed.status();
   const OcclusionEdges& oaocc = *computed;
   const int layers = geo.regions.num_layers();

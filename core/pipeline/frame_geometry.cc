@@ -67,6 +67,4 @@ BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, i
   return options;
 }
 
-OcclusionFeatureOptions OcclusionFeatureOptionsForFrame(const ModelBundle&, int, int) { return {}; }
-
 }  // namespace tod

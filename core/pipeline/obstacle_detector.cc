@@ -159,7 +159,6 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   const FrameGeometry geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
   const Result<OcclusionEdges> computed =
       ComputeOcclusionEdges(bgr, geometry.regions, *bundle_.edges, &bundle_.occlusion,
-                            OcclusionFeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows),
                             bundle_.params, /*enhance=*/true, &timer, &budget);
   if (!computed.ok()) return computed.status();
   if (!timer.stopped().ok()) return timer.stopped();

@@ -131,13 +131,11 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
   const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
     const ModelBundle& upstream = folds.For(bundle, i);
     const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-        s.image, bundle.regions, *upstream.edges, nullptr, {}, upstream.params, /*enhance=*/true);
+        s.image, bundle.regions, *upstream.edges, nullptr, upstream.params, /*enhance=*/true);
     if (!computed.ok()) return computed.status();
     const OcclusionEdges& oaocc = *computed;
-    const OcclusionTrainingFrame frame{
-        oaocc.crop, oaocc.enhanced, oaocc.superpixels, LabelMap(s)(oaocc.r1.rect()).clone(),
-        OcclusionFeaturesOnCrop(OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows),
-                                oaocc)};
+    const OcclusionTrainingFrame frame{oaocc.crop, oaocc.enhanced, oaocc.superpixels,
+                                       LabelMap(s)(oaocc.r1.rect()).clone()};
     auto samples = ExtractOcclusionSamples(frame, params, static_cast<std::size_t>(i));
     if (!samples.ok()) return samples.status();
     per_frame[i] = std::move(*samples);

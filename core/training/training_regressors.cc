@@ -70,8 +70,7 @@ Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundl
                                        const SampleSelectionParams& selection, std::uint64_t seed,
                                        bool truth_boxes) {
   const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-      s.image, bundle.regions, *upstream.edges, &upstream.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), upstream.params, true);
+      s.image, bundle.regions, *upstream.edges, &upstream.occlusion, upstream.params, true);
   if (!computed.ok()) return computed.status();
   const OcclusionEdges& oaocc = *computed;
   const ProposalSet all = ProposeBoxes(

@@ -157,9 +157,7 @@ int main(int argc, char** argv) {
   for (int f = 0; f < frames; ++f) {
     const tod::Sample frame = tod::GenerateSynthFrame(synth, 1000 + static_cast<unsigned>(f), "b");
     const tod::Result<tod::OcclusionEdges> computed = tod::ComputeOcclusionEdges(
-        frame.image, geometry.regions, *bundle->edges, &bundle->occlusion,
-        tod::OcclusionFeatureOptionsForFrame(*bundle, frame.image.cols, frame.image.rows),
-        bundle->params, true);
+        frame.image, geometry.regions, *bundle->edges, &bundle->occlusion, bundle->params, true);
     if (!computed.ok()) {
       std::cerr << computed.status().ToString() << "\n";
       return 1;

@@ -68,9 +68,8 @@ struct RoadFrameMaps {
   ModelBundle bundle = TinyBundle();
   cv::Mat3b frame = RoadFrame(512, 256);
   FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
-  Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
-      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
+  Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(frame, geometry.regions, *bundle.edges,
+                                                       &bundle.occlusion, bundle.params, true);
 };
 
 // A suite whose tests share one ObstacleDetector on TinyBundle() (training its forests once).
