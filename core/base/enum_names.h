@@ -24,6 +24,12 @@ std::string_view EnumName(E value) {
   return "?";
 }
 
+// The same as a std::string (for JSON and messages).
+template <typename E>
+std::string EnumString(E value) {
+  return std::string(EnumName(value));
+}
+
 template <typename E>
 std::optional<E> ParseEnum(std::string_view name) {
   for (const auto& [v, n] : EnumNames<E>::kTable)

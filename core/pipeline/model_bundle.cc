@@ -104,7 +104,7 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   manifest["format_version"] = kBundleFormatVersion;
   manifest["version"] = bundle.version;
   manifest["created"] = bundle.created.empty() ? NowIso8601() : bundle.created;
-  manifest["edge_source"] = std::string(EnumName(bundle.edge_kind));
+  manifest["edge_source"] = EnumString(bundle.edge_kind);
   if (bundle.edge_kind == EdgeKind::kSed) manifest["sed_model_file"] = kSedModelFile;
   manifest["params"] = ToJson(bundle.params);
   manifest["regions"] = bundle.regions.ToJson();

@@ -97,10 +97,10 @@ ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
   info_.format_version = kBundleFormatVersion;
   info_.created = bundle_.created;
   info_.trained_on = TrainedOn(bundle_.training);
-  info_.edge_source = std::string(EnumName(bundle_.edge_kind));
+  info_.edge_source = EnumString(bundle_.edge_kind);
   info_.manifest = {{"version", bundle_.version},
                     {"created", bundle_.created},
-                    {"edge_source", std::string(EnumName(bundle_.edge_kind))},
+                    {"edge_source", EnumString(bundle_.edge_kind)},
                     {"params", ToJson(bundle_.params)},
                     {"regions", bundle_.regions.ToJson()},
                     {"size_filter", bundle_.size_filter.ToJson()},

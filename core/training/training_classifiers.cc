@@ -55,14 +55,15 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
   switch (options.edge_source) {
     case EdgeKind::kGradient:
       bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
-      parts["edges"] = {{"kind", "gradient"}, {"learned", false}};
+      parts["edges"] = {{"kind", EnumString(EdgeKind::kGradient)}, {"learned", false}};
       ShareUnlearnedEdges(bundle, folds);
       return Status::Ok();
     case EdgeKind::kSed: {
       auto sed = CreateSedEdgeSource(options.sed_model);
       if (!sed.ok()) return sed.status().WithContext("loading the SED edge model");
       bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
-      parts["edges"] = {{"kind", "sed"}, {"learned", false}, {"model", options.sed_model}};
+      parts["edges"] = {
+          {"kind", EnumString(EdgeKind::kSed)}, {"learned", false}, {"model", options.sed_model}};
       ShareUnlearnedEdges(bundle, folds);
       return Status::Ok();
     }
@@ -101,7 +102,7 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
     return options.prior_correction ? c.sampled_odds_scale() : 1.0;
   };
   bundle.params.prior_correction.edge_odds = odds(*classifier);
-  parts["edges"] = {{"kind", "pixel_forest"},
+  parts["edges"] = {{"kind", EnumString(EdgeKind::kPixelForest)},
                     {"learned", true},
                     {"trained", true},
                     {"frames", which.size()},

@@ -30,7 +30,8 @@ Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, GroundPlaneFit& 
                         ModelBundle& bundle, nlohmann::json& parts) {
   if (run.options().size_filter_recipe == SizeFilterRecipe::kBands) {
     bundle.size_filter = SizeFilter::Derive(survey.obstacle_boxes);
-    parts["size_filter"] = {{"recipe", "bands"}, {"obstacles", survey.obstacle_boxes.size()}};
+    parts["size_filter"] = {{"recipe", EnumString(SizeFilterRecipe::kBands)},
+                            {"obstacles", survey.obstacle_boxes.size()}};
     return Status::Ok();
   }
   const Result<GroundPlaneSizePrior>& prior = ground_plane.Get();
@@ -39,7 +40,7 @@ Status DeriveSizeFilter(TrainingRun& run, const Survey& survey, GroundPlaneFit& 
         "fitting the size filter's ground-plane prior (too few "
         "obstacles? --paper size_filter needs none)");
   bundle.size_filter = GroundPlaneSizeFilter(*prior, survey.obstacle_boxes);
-  parts["size_filter"] = {{"recipe", "ground_plane"},
+  parts["size_filter"] = {{"recipe", EnumString(SizeFilterRecipe::kGroundPlane)},
                           {"obstacles", prior->obstacles},
                           {"horizon_y", prior->horizon_y},
                           {"h_per_row", {prior->h_ratio_min, prior->h_ratio_max}},
@@ -64,7 +65,7 @@ Status PlaceFeatureHorizons(TrainingRun& run, GroundPlaneFit& ground_plane, Mode
   GroundPlaneFeatureParams& params = bundle.params.box_features;
   params.ground_plane_size = run.options().box_size_features == BoxSizeFeatures::kGroundPlane;
   if (!params.ground_plane_size) {
-    parts["box_features"] = {{"size", "paper"}};
+    parts["box_features"] = {{"size", EnumString(BoxSizeFeatures::kPaper)}};
     return Status::Ok();
   }
   const Result<GroundPlaneSizePrior>& prior = ground_plane.Get();
@@ -73,7 +74,8 @@ Status PlaceFeatureHorizons(TrainingRun& run, GroundPlaneFit& ground_plane, Mode
         "placing the horizon of the ground-plane box_features (too few obstacles? --paper "
         "box_size_features needs none)");
   params.horizon_y = prior->horizon_y;
-  parts["box_features"] = {{"size", "ground_plane"}, {"horizon_y", params.horizon_y}};
+  parts["box_features"] = {{"size", EnumString(BoxSizeFeatures::kGroundPlane)},
+                           {"horizon_y", params.horizon_y}};
   char line[64];
   std::snprintf(line, sizeof line, ": sizes over the rows below row %.1f", params.horizon_y);
   run.Say(std::string("box_features") + line);
@@ -90,7 +92,7 @@ Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundl
   if (options.regions == RegionsSource::kLaf2020) {
     bundle.regions = Laf2020Regions().ScaledTo(survey.width, survey.height);
     bundle.size_filter = SizeFilter::Laf2020();
-    parts["size_filter"] = {{"recipe", "laf2020"}};
+    parts["size_filter"] = {{"recipe", EnumString(RegionsSource::kLaf2020)}};
     if (survey.width != 2048 || survey.height != 1024) {
       if (Status st = DeriveSizeFilter(run, survey, ground_plane, bundle, parts); !st.ok())
         return st;
