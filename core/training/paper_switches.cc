@@ -75,7 +75,9 @@ void ApplyPaperSwitch(PaperSwitch which, TrainOptions& options) {
       params.probability_map.superpixel_shares = false;
       return;
     case PaperSwitch::kOcclusionEarlyExit:
-      params.occlusion_screening = {};
+      // No trees screened: every pair walks the whole forest. The bound stays as recorded, so
+      // the manifest reads as `--occlusion-screen-trees 0` wrote it.
+      params.occlusion_screening.trees = 0;
       return;
   }
 }
