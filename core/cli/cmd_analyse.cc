@@ -4,6 +4,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
+#include "core/cli/dataset_options.h"
 #include "core/evaluation/loss_analysis.h"
 #include "core/pipeline/model_bundle.h"
 
@@ -11,20 +12,15 @@ namespace tod::cli {
 
 Runner AddAnalyseCommand(CLI::App& app) {
   struct Args {
+    DatasetArgs data = DatasetArgsOfSplit("test");
     LossAnalysisOptions analysis;
     std::string model, json;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "analyse", "where the obstacles of a split are lost: edges, proposals, filter, ranking");
-  cmd->add_option("--data", args->analysis.data_root, "dataset root")->required();
+  AddDatasetOptions(cmd, args->data, /*bad_frames=*/false);
   cmd->add_option("--model", args->model, "model bundle directory")->required();
-  cmd->add_option("--split", args->analysis.split, "split to analyse");
-  cmd->add_option("--format", args->analysis.format, "dataset format")
-      ->check(CLI::IsMember({"auto", "laf", "masks", "modd2"}));
-  cmd->add_option("--split-file", args->analysis.split_file,
-                  "masks format: `train|test <stem>` lines to use instead of DATA/split.txt");
-  cmd->add_option("--max-frames", args->analysis.max_frames, "at most this many frames (0 = all)");
   cmd->add_option("--threads", args->analysis.threads, "worker threads (0 = all cores)");
   cmd->add_option("--json", args->json, "write every obstacle's fate and frame's counts here");
   return [args] {
@@ -32,6 +28,7 @@ Runner AddAnalyseCommand(CLI::App& app) {
     auto bundle = LoadModelBundle(args->model);
     if (!bundle.ok()) return Fail(bundle.status().message());
     LossAnalysisOptions options = args->analysis;
+    options.data = DatasetSelectionFrom(args->data);
     options.progress = [](const std::string& line) { std::cerr << "analyse: " << line << "\n"; };
     auto analysis = AnalyseLosses(*bundle, options);
     if (!analysis.ok()) return Fail(analysis.status().message());

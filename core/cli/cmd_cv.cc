@@ -1,4 +1,4 @@
-// tod cv --data DIR --work DIR [--folds 5] [--seeds 1] [--seed S] [--json FILE]
+// tod cv --data DIR --work DIR [--folds 5] [--seeds 1] [--seed S] [--paper NAME] [--json FILE]
 // Cross-validates the training recipe (tod train's defaults) over K folds of consecutive frames
 // and N seeds (core/validation/cross_validation.h): trains on K-1 folds, evaluates on the one
 // left out, and prints the headline metrics per fold with their mean and min-max spread; the
@@ -7,6 +7,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
+#include "core/training/paper_switches.h"
 #include "core/validation/cross_validation.h"
 
 namespace tod::cli {
@@ -17,16 +18,17 @@ Runner AddCvCommand(CLI::App& app) {
     EvalOptions eval;
     CrossValidationOptions cv;
     std::string json;
+    std::vector<std::string> paper;
     int trees = 200;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "cv", "cross-validate the training recipe over folds of consecutive frames and seeds");
-  cmd->add_option("--data", args->recipe.data_root, "dataset root (masks layout)")->required();
+  cmd->add_option("--data", args->recipe.data.data_root, "dataset root (masks layout)")->required();
   cmd->add_option("--work", args->cv.work_dir,
                   "directory for the folds' split files (and, with --keep-models, bundles)")
       ->required();
-  cmd->add_option("--split-file", args->recipe.split_file,
+  cmd->add_option("--split-file", args->recipe.data.split_file,
                   "`train|test <stem>` lines: cross-validate over the frames it lists");
   cmd->add_option("--folds", args->cv.folds, "K: folds of consecutive frames")
       ->check(CLI::Range(2, 100))
@@ -38,14 +40,25 @@ Runner AddCvCommand(CLI::App& app) {
   cmd->add_option("--trees", args->trees, "trees per regressor (paper: 200)")
       ->check(CLI::Range(1, 2000))
       ->capture_default_str();
+  cmd->add_option("--classifier-frames", args->recipe.classifier_frames,
+                  "frames the edge and occlusion classifiers learn from (fewer: faster)")
+      ->capture_default_str();
+  cmd->add_option("--paper", args->paper,
+                  "train this part as the paper does, as tod train --paper (repeatable):" +
+                      PaperSwitchesHelp())
+      ->check(CLI::IsMember(EnumNameList<PaperSwitch>()))
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--threads", args->recipe.threads, "worker threads (0 = all cores)");
   cmd->add_flag("--keep-models", args->cv.keep_models, "keep every fold's bundle under --work");
   cmd->add_option("--json", args->json, "write every number under \"cv\" to this file");
   return [args] {
     BoundOpenCvThreads(args->recipe.threads);
     TrainOptions recipe = args->recipe;
-    recipe.format = "masks";
-    recipe.regressor.num_trees = args->trees;
+    recipe.data.format = "masks";
+    recipe.regressor_trees = args->trees;
+    for (const std::string& name : args->paper)
+      ApplyPaperSwitch(*ParseEnum<PaperSwitch>(name), recipe);  // checked by CLI11
     recipe.progress = [](const std::string& line) { std::cerr << "train: " << line << "\n"; };
     EvalOptions eval = args->eval;
     eval.threads = recipe.threads;

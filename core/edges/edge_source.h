@@ -10,27 +10,31 @@
 #include <vector>
 
 #include "core/base/binary_io.h"
+#include "core/base/enum_names.h"
 #include "core/base/status.h"
 #include "core/edges/edge_channels.h"
 #include "core/forest/random_forest.h"
 
 namespace tod {
 
-// Early exit for a tree-ensemble source (PixelEdgeClassifier): a cell whose mean over the first
-// `trees` trees is at most `final_at_most` (the classifier's own, balanced-sample probability)
-// keeps that mean; every other cell gets the whole forest, exactly as without screening.
-// trees = 0: every tree on every cell (the reference). Sources that are not tree ensembles
-// ignore it. The pipeline takes it from PipelineParams::edge_screening.
-using EdgeScreening = ForestScreening;
+// Which base edge map a bundle uses; its names are the manifest's "edge_source" and `tod train
+// --edge-source`.
+enum class EdgeKind { kPixelForest, kGradient, kSed };
+template <>
+struct EnumNames<EdgeKind> {
+  static constexpr std::array<std::pair<EdgeKind, std::string_view>, 3> kTable{{
+      {EdgeKind::kPixelForest, "pixel_forest"},
+      {EdgeKind::kGradient, "gradient"},
+      {EdgeKind::kSed, "sed"},
+  }};
+};
 
 class EdgeSource {
  public:
   virtual ~EdgeSource() = default;
   // bgr: 8-bit colour crop. Returns E with the crop's size, values in [0,1].
-  virtual cv::Mat1f Compute(const cv::Mat3b& bgr, const EdgeScreening& screening) const = 0;
-  // The reference: no early exit.
-  cv::Mat1f Compute(const cv::Mat3b& bgr) const { return Compute(bgr, EdgeScreening{}); }
-  virtual std::string kind() const = 0;  // "gradient", "pixel_forest", "sed"
+  virtual cv::Mat1f Compute(const cv::Mat3b& bgr) const = 0;
+  virtual EdgeKind kind() const = 0;
 };
 
 struct GradientEdgeParams {
@@ -99,9 +103,8 @@ class PixelEdgeClassifier : public EdgeSource {
   static Result<PixelEdgeClassifier> TrainOnSamples(const EdgeSamples& samples,
                                                     const PixelEdgeParams& params);
   bool trained() const { return !forest_.empty(); }
-  using EdgeSource::Compute;
-  cv::Mat1f Compute(const cv::Mat3b& bgr, const EdgeScreening& screening) const override;
-  std::string kind() const override { return "pixel_forest"; }
+  cv::Mat1f Compute(const cv::Mat3b& bgr) const override;
+  EdgeKind kind() const override { return EdgeKind::kPixelForest; }
   // Of the last TryTrain: (share of negative cells sampled) / (share of boundary cells sampled),
   // the odds factor that undoes the balanced sampling (PriorCorrection). Not stored in the file.
   double sampled_odds_scale() const { return sampled_odds_scale_; }

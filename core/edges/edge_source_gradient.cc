@@ -53,9 +53,7 @@ class GradientEdgeSource : public EdgeSource {
  public:
   explicit GradientEdgeSource(const GradientEdgeParams& params) : params_(params) {}
 
-  using EdgeSource::Compute;
-  cv::Mat1f Compute(const cv::Mat3b& bgr,
-                    const EdgeScreening& /*not a tree ensemble*/) const override {
+  cv::Mat1f Compute(const cv::Mat3b& bgr) const override {
     if (bgr.empty()) return {};
     const cv::Mat3f luv = TriangleSmooth(BgrToLuv(bgr), params_.smooth_radius);
     cv::Mat1f edge = ComputeColourGradient(luv, /*with_orientation=*/false).magnitude;
@@ -73,7 +71,7 @@ class GradientEdgeSource : public EdgeSource {
     return edge;
   }
 
-  std::string kind() const override { return "gradient"; }
+  EdgeKind kind() const override { return EdgeKind::kGradient; }
 
  private:
   GradientEdgeParams params_;

@@ -155,14 +155,13 @@ Result<PixelEdgeClassifier> PixelEdgeClassifier::TryTrain(
   return TrainOnSamples(all, params);
 }
 
-cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr, const EdgeScreening& screening) const {
+cv::Mat1f PixelEdgeClassifier::Compute(const cv::Mat3b& bgr) const {
   if (bgr.empty()) return {};
   if (forest_.empty()) return cv::Mat1f::zeros(bgr.size());
   const EdgeChannels channels = ComputeEdgeChannels(bgr, channel_params_);
   cv::Mat1f cell_map(channels.rows(), channels.cols());
   const PixelFeatureExtractor extractor(channels);
-  ForestWalkOptions walk;  // one thread: the rows are already shared out below
-  walk.screening = screening;
+  const ForestWalkOptions walk;  // one thread, every tree: the rows are already shared out below
   cv::parallel_for_(cv::Range(0, channels.rows()), [&](const cv::Range& rows) {
     cv::Mat1f row_features;
     for (int i = rows.start; i < rows.end; ++i) {

@@ -16,9 +16,7 @@ class SedEdgeSource : public EdgeSource {
   explicit SedEdgeSource(cv::Ptr<cv::ximgproc::StructuredEdgeDetection> detector)
       : detector_(std::move(detector)) {}
 
-  using EdgeSource::Compute;
-  cv::Mat1f Compute(const cv::Mat3b& bgr,
-                    const EdgeScreening& /*not a tree ensemble*/) const override {
+  cv::Mat1f Compute(const cv::Mat3b& bgr) const override {
     if (bgr.empty()) return {};
     cv::Mat3f rgb;
     bgr.convertTo(rgb, CV_32F, 1.0 / 255.0);  // the detector wants float RGB in [0,1]
@@ -30,7 +28,7 @@ class SedEdgeSource : public EdgeSource {
     return result;
   }
 
-  std::string kind() const override { return "sed"; }
+  EdgeKind kind() const override { return EdgeKind::kSed; }
 
  private:
   cv::Ptr<cv::ximgproc::StructuredEdgeDetection> detector_;

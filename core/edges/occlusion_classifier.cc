@@ -154,7 +154,7 @@ Result<OcclusionSamples> ExtractOcclusionSamples(const OcclusionTrainingFrame& f
     return Status::InvalidArgument(what + ": labels size differs from the image size");
   }
   const SuperpixelPairs pairs =
-      ComputeSuperpixelPairs(frame.image, frame.enhanced_edge, frame.superpixels, frame.features);
+      ComputeSuperpixelPairs(frame.image, frame.enhanced_edge, frame.superpixels);
   const std::vector<RegionTruth> truths =
       RegionTruths(frame.superpixels.labels, frame.superpixels.count, frame.labels);
   OcclusionSamples out;
@@ -268,8 +268,7 @@ Result<cv::Mat1f> OcclusionClassifier::Paint(const cv::Mat3b& image, const cv::M
   if (Status s = ValidateMaps(image, enhanced_edge, superpixels, "occlusion paint"); !s.ok()) {
     return s;
   }
-  const SuperpixelPairs pairs =
-      ComputeSuperpixelPairs(image, enhanced_edge, superpixels, options.features);
+  const SuperpixelPairs pairs = ComputeSuperpixelPairs(image, enhanced_edge, superpixels);
   std::vector<float> strength;
   if (trees_walked != nullptr) *trees_walked = 0;
   if (trained()) {

@@ -34,8 +34,6 @@ struct OcclusionParams {
 
 // How Paint measures and walks the pairs of one frame.
 struct OcclusionPaintOptions {
-  // Must measure sizes as the training frames' did (PipelineParams::occlusion_features).
-  OcclusionFeatureOptions features;
   // Early exit (PipelineParams::occlusion_screening; off by default): a pair whose mean over the
   // first trees is at most the bound keeps that mean (RandomForest::PredictBatchScreened).
   ForestScreening screening;
@@ -46,8 +44,7 @@ struct OcclusionTrainingFrame {
   cv::Mat3b image;          // R1 crop
   cv::Mat1f enhanced_edge;  // Ê on the crop
   Superpixels superpixels;
-  cv::Mat1i labels;                  // -1 ignore, 0 background, 1 road, >= 2 obstacle instance
-  OcclusionFeatureOptions features;  // as Paint will be given them
+  cv::Mat1i labels;  // -1 ignore, 0 background, 1 road, >= 2 obstacle instance
 };
 
 // Training pairs of one or more frames (rows of kNumOcclusionFeatures floats), with the number of

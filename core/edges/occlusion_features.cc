@@ -381,30 +381,13 @@ void PairFeatures(const cv::Mat1f& enhanced_edge, const PairPixels& pixels,
       static_cast<float>(small->sum_y / small->area - large->sum_y / large->area) * inv_height;
 }
 
-// OcclusionFeatureOptions::horizon_y: the size columns of every row from pixels (and crop
-// heights) to the rows below the horizon.
-void DivideSizesByGroundDistance(const OcclusionFeatureOptions& options, int crop_height,
-                                 cv::Mat1f& features) {
-  if (!options.horizon_y) return;
-  for (int p = 0; p < features.rows; ++p) {
-    float* f = features[p];
-    const double boundary_row = static_cast<double>(f[kBoundaryY]) * crop_height + options.crop_y;
-    const double d = std::max(1.0, boundary_row - *options.horizon_y);
-    f[kBoundaryLength] = static_cast<float>(f[kBoundaryLength] / d);
-    f[kAreaSmaller] = static_cast<float>(f[kAreaSmaller] / (d * d));
-    f[kAreaLarger] = static_cast<float>(f[kAreaLarger] / (d * d));
-    f[kVerticalOrder] = static_cast<float>(f[kVerticalOrder] * crop_height / d);
-  }
-}
-
 // Pairs per piece of the parallel feature loop: a real frame has ~16 000 pairs.
 constexpr int kPairsPerPiece = 1024;
 
 }  // namespace
 
 SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                                       const Superpixels& superpixels,
-                                       const OcclusionFeatureOptions& options) {
+                                       const Superpixels& superpixels) {
   SuperpixelPairs out;
   // The regions' appearance and the boundary scan read the same labels and nothing of each
   // other: on OpenCV's pool they run side by side (one after the other on one thread), each
@@ -433,7 +416,6 @@ SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& 
       PairFeatures(enhanced_edge, pixels, regions, out.pairs[p], p, inv_height, values,
                    out.features[p]);
   });
-  DivideSizesByGroundDistance(options, superpixels.labels.rows, out.features);
   return out;
 }
 

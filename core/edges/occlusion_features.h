@@ -34,17 +34,8 @@ enum OcclusionFeature : int {
   kNumOcclusionFeatures
 };
 
-// How the pair features measure size. Unset horizon: kBoundaryLength, kAreaSmaller, kAreaLarger
-// and kVerticalOrder in pixels (kVerticalOrder over the crop height), as §3.4. Set: lengths over
-// d and areas over d², d = max(1, frame row of the boundary's mean − horizon_y), the same physical
-// size at every distance (as the ground-plane box features, box_features.h; measured, not the
-// default: docs/findings.md#occlusion-size-features), and on frames of another size once the
-// horizon is mapped (frame_geometry.h).
-struct OcclusionFeatureOptions {
-  std::optional<double> horizon_y;  // frame row; may lie above the crop
-  int crop_y = 0;                   // frame row of the crop's first row
-};
-
+// Sizes are in pixels (kVerticalOrder over the crop height), as §3.4; over the rows below a
+// horizon they were measured and removed (docs/findings.md#occlusion-size-features).
 struct SuperpixelPairs {
   std::vector<cv::Vec2i> pairs;  // (a, b) with a < b, superpixel ids
   cv::Mat1f features;            // pairs.size() x kNumOcclusionFeatures
@@ -59,8 +50,7 @@ struct SuperpixelPairs {
 // pixel's 3x3 neighbourhood form a pair) and computes their features. Sizes must agree (the
 // caller validates); superpixels.labels must hold 0..count.
 SuperpixelPairs ComputeSuperpixelPairs(const cv::Mat3b& image, const cv::Mat1f& enhanced_edge,
-                                       const Superpixels& superpixels,
-                                       const OcclusionFeatureOptions& options);
+                                       const Superpixels& superpixels);
 
 // 0.5·Σ (p − q)² / (p + q) over bins where p + q > 0; inputs are normalised histograms.
 float ChiSquaredDistance(const float* p, const float* q, int bins);

@@ -54,9 +54,6 @@ Status ValidateSuperpixelInput(const cv::Mat3b& bgr, const cv::Mat1f& edge,
   if (params.iterations < 0) {
     return Status::InvalidArgument("sticky superpixels: params.iterations must be >= 0");
   }
-  if (params.strip_rows < 0) {
-    return Status::InvalidArgument("sticky superpixels: params.strip_rows must be >= 0");
-  }
   return Status::Ok();
 }
 
@@ -91,7 +88,7 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
     half_weights.position *= 4.0;
     std::vector<int> half_labels = OneLabelPerPixel(half_w, half_h);
     RefineStickyLabels(ViewOf(smooth_half, edge_half), half_weights, 2 * params.iterations,
-                       half_labels, params.strip_rows / 2);
+                       half_labels);
     // Nearest ×2 upsampling; odd last row/column replicate their neighbour.
     flat.resize(static_cast<size_t>(width) * height);
     ForEachRowBand(height, [&](const cv::Range& rows) {
@@ -109,8 +106,7 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
   }
 
   const cv::Mat3f smooth_full = SmoothStickyColour(colour);
-  RefineStickyLabels(ViewOf(smooth_full, edge_full), weights, params.iterations, flat,
-                     params.strip_rows);
+  RefineStickyLabels(ViewOf(smooth_full, edge_full), weights, params.iterations, flat);
 
   Superpixels result;
   result.labels = cv::Mat1i(height, width);

@@ -13,12 +13,6 @@ struct StickySuperpixelParams {
   float alpha = 0.5f;  // regularity vs data
   float beta = 0.9f;   // edge vs colour
   int iterations = 4;  // full-resolution iterations (2x at half resolution)
-  // Sweep order (RefineStickyLabels): 0 = raster order (the reference and the default; with the
-  // request's threads, several sweeps at once, each following the one before, same labels);
-  // n > 0 = strips of n full-resolution rows, side by side on the request's threads.
-  // Strips of 32 rows make the stage ~1.3x faster on two threads but cost pixel metrics on real
-  // frames (README, Speed), so a bundle takes them only when trained so (--superpixel-strips).
-  int strip_rows = 0;
 };
 
 struct Superpixels {
@@ -37,7 +31,7 @@ Result<Superpixels> ComputeStickySuperpixels(const cv::Mat3b& bgr, const cv::Mat
 cv::Mat3f SmoothStickyColour(const cv::Mat3f& colour);
 
 // Non-empty image, edge map of the same size and finite, k > 0, alpha and beta in [0,1],
-// iterations >= 0, strip_rows >= 0.
+// iterations >= 0.
 Status ValidateSuperpixelInput(const cv::Mat3b& bgr, const cv::Mat1f& edge,
                                const StickySuperpixelParams& params);
 

@@ -87,17 +87,6 @@ StickyWeights StickyWeightsFor(int k, double alpha, double beta) {
 
 namespace {
 
-// Rows [first, last] a label's pixels lay in at some point of the current sweep (a superset of
-// where they lie now: a pixel leaving a label does not shrink it).
-struct RowExtent {
-  int first = std::numeric_limits<int>::max();
-  int last = -1;
-  void Add(int row) {
-    first = std::min(first, row);
-    last = std::max(last, row);
-  }
-};
-
 // The state one refinement works on and the move of one pixel (ALGORITHM.md §3.2(1)).
 class StickyRefiner {
  public:
@@ -114,15 +103,6 @@ class StickyRefiner {
     return (x > 0 && labels_[i - 1] != own) || (y > 0 && labels_[i - image_.width] != own) ||
            (x + 1 < image_.width && labels_[i + 1] != own) ||
            (y + 1 < image_.height && labels_[i + image_.width] != own);
-  }
-
-  // Whether the move of pixel (x, y) would read or write the sums of a label `blocked` marks.
-  bool Touches(int x, int y, const std::vector<char>& blocked) const {
-    const size_t i = static_cast<size_t>(y) * image_.width + x;
-    return blocked[labels_[i]] || (x > 0 && blocked[labels_[i - 1]]) ||
-           (y > 0 && blocked[labels_[i - image_.width]]) ||
-           (x + 1 < image_.width && blocked[labels_[i + 1]]) ||
-           (y + 1 < image_.height && blocked[labels_[i + image_.width]]);
   }
 
   // Moves the border pixel (x, y) to the neighbouring label of least cost (ties go to its own
@@ -190,7 +170,6 @@ class StickyRefiner {
     if (best == own) return false;
     sums_[own].Add(-1.0, x, y, c);
     sums_[best].Add(1.0, x, y, c);
-    if (!extents_.empty()) extents_[best].Add(y);
     if (last_row_) {
       // One writer per label at a time (SweepChain), so a load and a store suffice.
       std::atomic<int>& last = last_row_[best];
@@ -200,50 +179,21 @@ class StickyRefiner {
     return true;
   }
 
-  // Rows [y_begin, y_end) in raster order; returns the pixels moved. With `shared`, the pixels
-  // whose move would touch a label it marks are not moved but appended to `deferred`.
-  long long SweepRows(int y_begin, int y_end, const std::vector<char>* shared,
-                      std::vector<int>* deferred) {
+  // One sweep in raster order (the reference order); returns the pixels moved.
+  long long SweepRaster() {
     long long moved = 0;
-    for (int y = y_begin; y < y_end; ++y)
-      for (int x = 0; x < image_.width; ++x) {
-        if (!OnBorder(x, y)) continue;
-        if (shared != nullptr && Touches(x, y, *shared))
-          deferred->push_back(y * image_.width + x);
-        else
-          moved += Move(x, y);
-      }
+    for (int y = 0; y < image_.height; ++y)
+      for (int x = 0; x < image_.width; ++x)
+        if (OnBorder(x, y)) moved += Move(x, y);
     return moved;
   }
-
-  // One sweep in raster order (the reference order); returns the pixels moved.
-  long long SweepRaster() { return SweepRows(0, image_.height, nullptr, nullptr); }
 
   // `count` raster sweeps at once, each a few rows behind the one before it, with exactly the
   // moves of the sweeps one after the other (see RefineStickyLabels); returns the pixels each
   // moved.
   std::vector<long long> SweepChain(int count);
 
-  // One sweep in strips of strip_rows rows, the first one `shift` rows short: the even strips side
-  // by side, then the odd ones, each in raster order (see RefineStickyLabels). Needs the extents
-  // (ResetExtents), and keeps them.
-  long long SweepStrips(int strip_rows, int shift);
-
-  // Every label's rows as they are now; the moves then only grow them.
-  void ResetExtents() {
-    extents_.assign(sums_.size(), RowExtent{});
-    for (int y = 0; y < image_.height; ++y)
-      for (int x = 0; x < image_.width; ++x)
-        extents_[labels_[static_cast<size_t>(y) * image_.width + x]].Add(y);
-  }
-
  private:
-  // Labels whose sums more than one strip of `parity` may touch. A strip's moves read and write
-  // the sums of the labels of its rows and of the row on either side (rows of strips of the other
-  // parity, which stand still meanwhile), so a label may be touched by every strip of `parity`
-  // whose rows, grown by one on each side, meet its extent.
-  std::vector<char> SharedLabels(int strip_rows, int shift, int parity) const;
-
   // Sweep `index` of a chain, in raster order; publishes the rows it has finished in
   // done[index]. From index 1 on it waits until the sweeps ahead can no longer touch what it reads.
   long long SweepInChain(std::vector<std::atomic<int>>& done, int index);
@@ -262,7 +212,6 @@ class StickyRefiner {
   const StickyWeights& weights_;
   std::vector<int>& labels_;
   std::vector<LabelSums> sums_;
-  std::vector<RowExtent> extents_;  // per label, kept by SweepStrips
   // Per label during SweepChain: a bound on the last row its pixels lie in (moves only raise it).
   std::unique_ptr<std::atomic<int>[]> last_row_;
 };
@@ -346,60 +295,10 @@ int StickyRefiner::LastRowAround(int x, int y) const {
   return reach;
 }
 
-std::vector<char> StickyRefiner::SharedLabels(int strip_rows, int shift, int parity) const {
-  std::vector<char> shared(sums_.size(), 0);
-  for (size_t label = 0; label < extents_.size(); ++label) {
-    const RowExtent& e = extents_[label];
-    if (e.last < 0) continue;
-    // In rows counted from `shift` rows above the first, strip s touches rows [s·n − 1, (s+1)·n]:
-    // it meets [first, last] for ceil(first / n) − 1 <= s <= (last + 1) / n.
-    const int first = e.first + shift, last = e.last + shift;
-    int first_strip = std::max(0, (first + strip_rows - 1) / strip_rows - 1);
-    int last_strip = (last + 1) / strip_rows;
-    if ((first_strip & 1) != parity) ++first_strip;
-    if ((last_strip & 1) != parity) --last_strip;
-    shared[label] = last_strip > first_strip;
-  }
-  return shared;
-}
-
-long long StickyRefiner::SweepStrips(int strip_rows, int shift) {
-  const int height = image_.height, width = image_.width;
-  const int strips = (height + shift + strip_rows - 1) / strip_rows;
-  long long moved = 0;
-  for (int parity = 0; parity < 2; ++parity) {
-    const std::vector<char> shared = SharedLabels(strip_rows, shift, parity);
-    // Usually no label reaches over a whole strip: then no pixel needs the check.
-    const bool any_shared = std::find(shared.begin(), shared.end(), 1) != shared.end();
-    const int count = (strips - parity + 1) / 2;  // strips parity, parity + 2, ...
-    std::vector<long long> moved_in(count, 0);
-    std::vector<std::vector<int>> deferred(count);  // pixel indices, raster order per strip
-    // The strips of one parity share no label they may move (SharedLabels): their moves touch
-    // disjoint sums, and they can run side by side, on OpenCV's pool.
-    cv::parallel_for_(cv::Range(0, count), [&](const cv::Range& range) {
-      for (int j = range.start; j < range.end; ++j) {
-        const int strip = parity + 2 * j;
-        moved_in[j] = SweepRows(std::max(0, strip * strip_rows - shift),
-                                std::min(height, (strip + 1) * strip_rows - shift),
-                                any_shared ? &shared : nullptr, &deferred[j]);
-      }
-    });
-    // Pixels next to a label several strips may touch: after the strips, in raster order.
-    for (int j = 0; j < count; ++j) {
-      moved += moved_in[j];
-      for (const int i : deferred[j]) {
-        const int x = i % width, y = i / width;
-        if (OnBorder(x, y)) moved += Move(x, y);
-      }
-    }
-  }
-  return moved;
-}
-
 }  // namespace
 
 int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, int iterations,
-                       std::vector<int>& labels, int strip_rows) {
+                       std::vector<int>& labels) {
   const int width = image.width;
   const int height = image.height;
   if (width <= 0 || height <= 0 || labels.empty()) return 0;
@@ -420,11 +319,8 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
   }
   for (LabelSums& s : sums) s.inverse_count = s.count > 0 ? 1.0 / s.count : 0.0;
 
-  // Strips only pay off when there are several of them.
-  const bool in_strips = strip_rows > 0 && height > 2 * strip_rows;
-  if (in_strips) refiner.ResetExtents();
   // The raster order on several threads: as many sweeps at once, each rows behind the one before.
-  const int chain = in_strips ? 1 : std::max(1, cv::getNumThreads());
+  const int chain = std::max(1, cv::getNumThreads());
   int sweeps = 0;
   const size_t pixels = static_cast<size_t>(width) * height;
   for (int iter = 0; iter < iterations;) {
@@ -445,14 +341,7 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
       iter += count;
     } else {
       ++sweeps;
-      // The first sweep runs in raster order: from one label per pixel, strips started afresh at
-      // every strip border and left 5-10 % more boundary pixels on the border rows (and 2-5 % more
-      // superpixels on real frames). Later sweeps shift the strips by half a strip every other
-      // time, so that no row is always a border where the order changes.
-      const long long moved = in_strips && iter > 0
-                                  ? refiner.SweepStrips(strip_rows, (iter % 2) * (strip_rows / 2))
-                                  : refiner.SweepRaster();
-      if (moved == 0) break;
+      if (refiner.SweepRaster() == 0) break;
       ++iter;
     }
     if (iter < iterations) {
@@ -460,10 +349,7 @@ int RefineStickyLabels(const StickyImage& image, const StickyWeights& weights, i
       // next to a sweep).
       const auto alive =
           std::count_if(sums.begin(), sums.end(), [](const LabelSums& s) { return s.count > 0; });
-      if (2 * static_cast<size_t>(alive) <= sums.size()) {
-        RenumberDensely(labels, sums, original_id);
-        if (in_strips) refiner.ResetExtents();  // indexed by the new ids, and tight again
-      }
+      if (2 * static_cast<size_t>(alive) <= sums.size()) RenumberDensely(labels, sums, original_id);
     }
   }
   for (int& label : labels) label = original_id[label];

@@ -140,8 +140,7 @@ class EvalTotals {
 }  // namespace
 
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options) {
-  auto selection = SelectFrames(
-      {options.data_root, options.split, options.format, options.split_file, options.max_frames});
+  auto selection = SelectFrames(options.data.Spec());
   if (!selection.ok()) return selection.status();
   const Dataset& dataset = *selection->dataset;
   const int n = static_cast<int>(selection->frames.size());
@@ -163,8 +162,8 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   });
   EvalReport report;
   const Status bad = ApplyBadFramePolicy(
-      per_frame, [&](int i) { return dataset.name(selection->frames[i]); }, options.on_bad_frame,
-      &report.skipped);
+      per_frame, [&](int i) { return dataset.name(selection->frames[i]); },
+      options.data.on_bad_frame, &report.skipped);
   if (!bad.ok()) return bad;
   report.frames = n - static_cast<int>(report.skipped.size());
   report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/datasets/bad_frames.h"
+#include "core/datasets/dataset_selection.h"
 #include "core/evaluation/frame_evaluation.h"
 #include "core/metrics/pixel_histogram_metrics.h"
 #include "core/metrics/pixel_roc.h"
@@ -20,13 +20,8 @@
 namespace tod {
 
 struct EvalOptions {
-  std::string data_root;
-  std::string format = "auto";
-  std::string split = "test";
-  std::string split_file;  // masks: instead of <data_root>/split.txt
-  int max_frames = 0;      // 0 = all
+  DatasetSelection data;  // the test split by default
   int threads = 0;
-  BadFramePolicy on_bad_frame = BadFramePolicy::kFail;
   std::function<void(const std::string&)> progress;
 };
 
@@ -63,7 +58,7 @@ struct EvalReport {
   // scores the same, so the calibrated map is the superpixel shares alone and none is reported.
   bool calibration_flat = false;
   // The regressors' row width and which features they are (ProposalFeatureSet): the paper's 20,
-  // with the vertical edge share and the orientation entropy when the bundle has them.
+  // with the vertical edge share and the road-surround feature when the bundle has them.
   int proposal_features = 0;
   std::string proposal_feature_set;
   int instances = 0;

@@ -35,9 +35,8 @@ Status AddPlainEdgeBaselines(const ModelBundle& bundle, const Sample& s, const F
   const OcclusionClassifier untrained_boundaries;
   PipelineParams plain_params = bundle.params;
   plain_params.prior_correction.occlusion_odds = 1.0;  // mean E is no classifier probability
-  const Result<OcclusionEdges> computed =
-      ComputeOcclusionEdges(s.image, geo.regions, *bundle.edges, &untrained_boundaries,
-                            OcclusionFeatureOptions{}, plain_params, /*enhance=*/false);
+  const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
+      s.image, geo.regions, *bundle.edges, &untrained_boundaries, plain_params, /*enhance=*/false);
   if (!computed.ok()) return computed.status();
   const OcclusionEdges& plain = *computed;
   out.ranked["EB"] = EdgeBoxesBaseline(plain.base_edge, plain.r1, kEvalMaxProposals);

@@ -219,8 +219,7 @@ std::string FormatScoreComparison(const LossAnalysis& a) {
 }  // namespace
 
 Result<LossAnalysis> AnalyseLosses(const ModelBundle& bundle, const LossAnalysisOptions& options) {
-  auto selection = SelectFrames(
-      {options.data_root, options.split, options.format, options.split_file, options.max_frames});
+  auto selection = SelectFrames(options.data.Spec());
   if (!selection.ok()) return selection.status();
   const int n = static_cast<int>(selection->frames.size());
   std::vector<FrameResult> results(n);
@@ -246,14 +245,17 @@ Result<LossAnalysis> AnalyseLosses(const ModelBundle& bundle, const LossAnalysis
       options.progress("analysed " + std::to_string(done) + "/" + std::to_string(n) + " frames");
     return Status::Ok();
   });
-  for (int i = 0; i < n; ++i)
-    if (!per_frame[i].ok())
-      return per_frame[i].WithContext("frame " + selection->dataset->name(selection->frames[i]));
+  std::vector<SkippedFrame> skipped;
+  const Status bad = ApplyBadFramePolicy(
+      per_frame, [&](int i) { return selection->dataset->name(selection->frames[i]); },
+      options.data.on_bad_frame, &skipped);
+  if (!bad.ok()) return bad;
   LossAnalysis out;
   out.pixel_ap = {pixels[0].Ap(), pixels[1].Ap(), pixels[2].Ap()};
-  for (FrameResult& r : results) {
-    out.frames.push_back(r.work);
-    out.obstacles.insert(out.obstacles.end(), r.fates.begin(), r.fates.end());
+  for (int i = 0; i < n; ++i) {
+    if (!per_frame[i].ok()) continue;
+    out.frames.push_back(results[i].work);
+    out.obstacles.insert(out.obstacles.end(), results[i].fates.begin(), results[i].fates.end());
   }
   return out;
 }

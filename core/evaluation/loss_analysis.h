@@ -15,16 +15,13 @@
 
 #include "core/base/status.h"
 #include "core/base/types.h"
+#include "core/datasets/dataset_selection.h"
 #include "core/pipeline/model_bundle.h"
 
 namespace tod {
 
 struct LossAnalysisOptions {
-  std::string data_root;
-  std::string format = "auto";
-  std::string split = "test";
-  std::string split_file;
-  int max_frames = 0;
+  DatasetSelection data;  // the test split by default; skipped frames are left out of every count
   int threads = 0;
   double hit_iou = 0.5;  // a proposal "finds" an obstacle at box IoU >= this
   int top_n = 1000;      // the paper's largest proposal budget

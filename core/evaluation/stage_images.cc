@@ -184,7 +184,6 @@ Result<StageImages> RenderStageImages(const FrameTrace& trace, const cv::Mat3b& 
     region["windows_nonzero"] = stats.windows_nonzero;
     region["windows_refined"] = stats.windows_refined;
     region["boxes_after_nms"] = stats.boxes_out;
-    region["rescans"] = stats.rescans;
     region["proposals_kept"] = boxes.size();
     region["proposals_drawn"] = drawn;
     counts["regions"].push_back(std::move(region));

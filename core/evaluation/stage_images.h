@@ -42,11 +42,11 @@ struct StageImages {
   //  "base_edge_pixels" (E > threshold), "enhanced_edge_pixels" (Ê > threshold),
   //  "superpixels", "occlusion_edge_pixels" (> threshold),
   //  "regions":[{"name","x","y","w","h","edge_pixels","edge_groups","windows_scored",
-  //              "windows_nonzero","windows_refined","boxes_after_nms","rescans",
+  //              "windows_nonzero","windows_refined","boxes_after_nms",
   //              "proposals_kept","proposals_drawn"}],
   //  "proposals_total"}; `tod detect` adds "image", the input's path.
   // Per region, edge_pixels / edge_groups describe its occlusion map normalised to max 1 as the
-  // scorer sees it (pixels > EdgeBoxParams::edge_min_mag), windows_* and rescans are the
+  // scorer sees it (pixels > EdgeBoxParams::edge_min_mag), windows_* are the
   // scorer's EdgeBoxStats, boxes_after_nms counts its output before the size filter's final
   // pass and proposals_kept after it. proposals_total is what the detector regresses.
   nlohmann::json counts;

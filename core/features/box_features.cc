@@ -69,17 +69,12 @@ Status ValidateShared(const ColourIntegrals* frame_colour, const cv::Mat1f& regi
 Status ValidateVertical(const VerticalEdgeIntegrals* frame_vertical,
                         const BoxFeatureOptions& options, const cv::Mat1f& region_map,
                         cv::Point region_origin) {
-  if (!options.vertical_edges && !options.orientation_entropy) return Status::Ok();
+  if (!options.vertical_edges) return Status::Ok();
   if (frame_vertical == nullptr) {
     return Status::InvalidArgument(
-        "BoxFeatureExtractor: options.vertical_edges / orientation_entropy need the frame's "
-        "vertical-edge tables "
+        "BoxFeatureExtractor: options.vertical_edges needs the frame's vertical-edge tables "
         "(frame_vertical is null)");
   }
-  if (options.orientation_entropy && !frame_vertical->has_orientation_tables())
-    return Status::InvalidArgument(
-        "BoxFeatureExtractor: options.orientation_entropy needs frame_vertical built with "
-        "orientation tables");
   return RegionInsideCrop(region_map.size(), region_origin, frame_vertical->size(),
                           frame_vertical->origin(), "frame_vertical");
 }
@@ -136,10 +131,8 @@ BoxFeatureExtractor::BoxFeatureExtractor(const cv::Mat1f& region_map, const cv::
   colour_ = std::make_shared<const ColourIntegrals>(region_bgr, region_origin);
   region_in_colour_ = cv::Rect(cv::Point(0, 0), region_map.size());
   if (options_.road_surround) road_hist_ = colour_->Histogram(RoadPatch(colour_->size()));
-  if (options_.vertical_edges || options_.orientation_entropy)
-    vertical_ = std::make_shared<const VerticalEdgeIntegrals>(
-        region_bgr, region_origin,
-        VerticalEdgeParams{.orientation_tables = options_.orientation_entropy});
+  if (options_.vertical_edges)
+    vertical_ = std::make_shared<const VerticalEdgeIntegrals>(region_bgr, region_origin);
 }
 
 BoxFeatureExtractor::BoxFeatureExtractor(
@@ -158,7 +151,7 @@ BoxFeatureExtractor::BoxFeatureExtractor(
   region_in_colour_ = cv::Rect(region_origin - frame_colour->origin(), region_map.size());
   colour_ = std::move(frame_colour);
   if (options_.road_surround) road_hist_ = colour_->Histogram(RoadPatch(colour_->size()));
-  if (options_.vertical_edges || options_.orientation_entropy) {
+  if (options_.vertical_edges) {
     region_in_vertical_ = region_origin - frame_vertical->origin();
     vertical_ = std::move(frame_vertical);
   }
@@ -267,14 +260,10 @@ void BoxFeatureExtractor::AddColourSpread(const cv::Rect& r, BoxFeatureVector& f
   }
 }
 
-// The optional features after the paper's 20: the share of strong gradient on near-vertical
-// edges, then the orientation entropy.
+// The optional feature after the paper's 20: the share of strong gradient on near-vertical edges.
 void BoxFeatureExtractor::AddEdgeOrientation(const cv::Rect& r, BoxFeatureVector& f) const {
   const cv::Rect box_in_vertical(r.tl() + region_in_vertical_, r.size());
   if (options_.vertical_edges) f[20] = static_cast<float>(vertical_->Share(box_in_vertical));
-  if (options_.orientation_entropy)
-    f[options_.vertical_edges ? 21 : 20] =
-        static_cast<float>(vertical_->OrientationEntropy(box_in_vertical));
 }
 
 // Features 18-20: histogram of the box against its surround ring = (box grown by w/2 left and
@@ -301,8 +290,7 @@ void BoxFeatureExtractor::AddSurroundContrast(const cv::Rect& r, BoxFeatureVecto
   const std::array<float, 3> contrast = HsvCosineDistances(box_hist, ring_hist);
   std::copy(contrast.begin(), contrast.end(), f.begin() + 17);
   if (options_.road_surround) {
-    const int index = kNumBoxFeatures + (options_.vertical_edges ? 1 : 0) +
-                      (options_.orientation_entropy ? 1 : 0);
+    const int index = kNumBoxFeatures + (options_.vertical_edges ? 1 : 0);
     const std::array<float, 3> unlike_road = HsvCosineDistances(ring_hist, road_hist_);
     f[index] = (unlike_road[0] + unlike_road[1] + unlike_road[2]) / 3.f;
   }

@@ -5,10 +5,8 @@
 //  10 X centre, 11 Y centre, 12 width, 13 height (full-image coordinates / actual image size),
 //  14-16 H/S/V standard deviation, 17-19 H/S/V contrast against the surround ring;
 //  with BoxFeatureOptions::vertical_edges one more (ours): 20 the vertical edge share
-//  (vertical_edges.h); with orientation_entropy one more after those (ours): 21 (20 without
-//  vertical_edges) the orientation entropy of the box's strong gradients (vertical_edges.h);
-//  with road_surround one more after those (ours): how unlike the road in front of the car the
-//  surround ring is (RoadPatch below).
+//  (vertical_edges.h); with road_surround one more after those (ours): how unlike the road in front
+//  of the car the surround ring is (RoadPatch below).
 //
 // Cost model (1800 x 620 region): construction is one pass over the edge map (runs of one value
 // per row, sparse_edge_map.h: 12 B per run) plus, unless a frame-wide ColourIntegrals is shared,
@@ -43,10 +41,10 @@
 
 namespace tod {
 
-// The paper's 20 features; a row has one more with each of BoxFeatureOptions::vertical_edges,
-// orientation_entropy and road_surround.
+// The paper's 20 features; a row has one more with each of BoxFeatureOptions::vertical_edges and
+// road_surround.
 inline constexpr int kNumBoxFeatures = 20;
-inline constexpr int kMaxBoxFeatures = kNumBoxFeatures + 3;
+inline constexpr int kMaxBoxFeatures = kNumBoxFeatures + 2;
 // Compute()'s result: the row's NumBoxFeatures(options) entries, the rest 0.
 using BoxFeatureVector = std::array<float, kMaxBoxFeatures>;
 
@@ -68,9 +66,6 @@ struct BoxFeatureOptions {
   // Feature 21 (index 20), the share of the box's strong gradient on near-vertical edges
   // (vertical_edges.h). Off: the paper's 20 features.
   bool vertical_edges = false;
-  // One more feature after those (index 21, or 20 without vertical_edges): the orientation
-  // entropy of the box's strong gradients (vertical_edges.h, the same tables).
-  bool orientation_entropy = false;
   // One more feature after those (ours): how unlike the road the box's surround is, the mean
   // over H, S and V of the cosine distance between the histograms of the surround ring of
   // features 18-20 and of the road just in front of the car (RoadPatch of the colour crop: R1's
@@ -84,19 +79,17 @@ struct BoxFeatureOptions {
 // which are fitted to the training obstacles' rows, not by any frame's content.
 cv::Rect RoadPatch(cv::Size crop);
 
-// Columns of a feature row under `options`: 20, plus one for each of vertical_edges,
-// orientation_entropy and road_surround.
+// Columns of a feature row under `options`: 20, plus one for each of vertical_edges and
+// road_surround.
 inline int NumBoxFeatures(const BoxFeatureOptions& options) {
-  return kNumBoxFeatures + (options.vertical_edges ? 1 : 0) +
-         (options.orientation_entropy ? 1 : 0) + (options.road_surround ? 1 : 0);
+  return kNumBoxFeatures + (options.vertical_edges ? 1 : 0) + (options.road_surround ? 1 : 0);
 }
 
 class BoxFeatureExtractor {
  public:
   // region_map: occlusion edge map of the region crop; region_bgr: colour crop of the same size;
   // region_origin: crop's top-left in the full image; image_size: full frame size.
-  // Builds the colour tables (and, with options.vertical_edges or orientation_entropy, the
-  // vertical-edge tables) of this
+  // Builds the colour tables (and, with options.vertical_edges, the vertical-edge tables) of this
   // crop itself; prefer the shared form below when several regions of one frame are measured.
   // On invalid input (sizes differ, crop outside the frame, non-finite map values) the extractor
   // is empty, status() says why, and Compute() returns zeros except the objectness.
@@ -109,9 +102,8 @@ class BoxFeatureExtractor {
   // locates that crop in the full image; the region [region_origin, + region_map.size()) must lie
   // inside it. The surround ring of features 17-19 is still clipped to this region. Gives the
   // same features as the constructor above on the same region (up to double rounding in 14-16).
-  // With options.vertical_edges or orientation_entropy, frame_vertical holds the vertical-edge
-  // tables of the same larger crop (required, with orientation tables for orientation_entropy;
-  // features 21 and 22 then differ from the per-region form only in the region's border
+  // With options.vertical_edges, frame_vertical holds the vertical-edge tables of the same larger
+  // crop (required; feature 21 then differs from the per-region form only in the region's border
   // pixels, where the per-region tables reflect the crop instead of reading the frame).
   BoxFeatureExtractor(std::shared_ptr<const ColourIntegrals> frame_colour,
                       const cv::Mat1f& region_map, cv::Point region_origin, cv::Size image_size,
@@ -149,7 +141,7 @@ class BoxFeatureExtractor {
   void AddEdgeFeatures(const cv::Rect& r, BoxFeatureVector& f) const;      // 1-7
   void AddPlaceFeatures(const cv::Rect& r, BoxFeatureVector& f) const;     // 8, 9, 11-14
   void AddColourSpread(const cv::Rect& r, BoxFeatureVector& f) const;      // 15-17
-  void AddEdgeOrientation(const cv::Rect& r, BoxFeatureVector& f) const;   // 21 (and 22)
+  void AddEdgeOrientation(const cv::Rect& r, BoxFeatureVector& f) const;   // 21
   void AddSurroundContrast(const cv::Rect& r, BoxFeatureVector& f) const;  // 18-20 (and road)
 
   Status status_;
@@ -161,7 +153,7 @@ class BoxFeatureExtractor {
   std::shared_ptr<const ColourIntegrals> colour_;
   cv::Rect region_in_colour_;    // the region in colour_'s crop coordinates
   ColourHistogram road_hist_{};  // RoadPatch of colour_'s crop, with options_.road_surround
-  // null unless options_.vertical_edges or orientation_entropy
+  // null unless options_.vertical_edges
   std::shared_ptr<const VerticalEdgeIntegrals> vertical_;
   cv::Point region_in_vertical_;  // the region's corner in vertical_'s crop
 };

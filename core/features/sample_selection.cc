@@ -86,11 +86,6 @@ Status ValidateSelectionInput(const Sample& gt, const std::vector<int>& range_li
   if (!(params.hard_fraction >= 0.0 && params.hard_fraction <= 1.0)) {
     return Status::InvalidArgument(where + "params.hard_fraction must lie in [0, 1]");
   }
-  if (params.negative_bags < 1 || params.negative_bags > kMaxNegativeBags) {
-    return Status::InvalidArgument(where + "params.negative_bags must lie in [1, " +
-                                   std::to_string(kMaxNegativeBags) + "], got " +
-                                   std::to_string(params.negative_bags));
-  }
   if (gt.road.empty()) {
     return Status::InvalidArgument(where + "the road mask is empty; categories need it");
   }
@@ -197,37 +192,20 @@ class NegativeSampler {
         num_ranges_(num_ranges),
         params_(params),
         rng_(seed),
-        is_positive_(proposals.size(), 0),
-        drawn_before_(proposals.size(), 0) {
+        is_positive_(proposals.size(), 0) {
     for (const int i : positives) is_positive_[i] = 1;
   }
 
-  // The negatives of `wanted` of every bag, in bag order; `bags` gets kEveryBag for each of the
-  // `positives` positives and then the bag of each negative. Each bag draws from what the
-  // earlier bags left, so the bags are disjoint.
-  std::vector<int> DrawBags(ProposalCategory wanted, const std::vector<int>& counts,
-                            std::size_t positives, std::vector<int>& bags) {
-    std::fill(drawn_before_.begin(), drawn_before_.end(), 0);
-    std::vector<int> negatives;
-    bags.assign(positives, SelectedSamples::kEveryBag);
-    for (int bag = 0; bag < params_.negative_bags; ++bag) {
-      const std::vector<int> drawn = DrawOneBag(wanted, counts);
-      negatives.insert(negatives.end(), drawn.begin(), drawn.end());
-      bags.insert(bags.end(), drawn.size(), bag);
-    }
-    return negatives;
-  }
-
- private:
-  // Per vertical range k, counts[k] negatives of `wanted`, hard ones (objectness above
-  // hard_objectness) and easy ones as DrawNegatives shares them.
-  std::vector<int> DrawOneBag(ProposalCategory wanted, const std::vector<int>& counts) {
+  // Per vertical range k, counts[k] negatives of `wanted` that are not positives, hard ones
+  // (objectness above hard_objectness) and easy ones as DrawNegatives shares them. Each call
+  // draws afresh from one random stream, so ORDR's and OBDR's draws are independent.
+  std::vector<int> Draw(ProposalCategory wanted, const std::vector<int>& counts) {
     std::vector<int> negatives;
     for (int k = 0; k < num_ranges_; ++k) {
       std::vector<int> hard, easy;
       for (int i = 0; i < static_cast<int>(proposals_.size()); ++i) {
         if (labels_.range[i] != k || labels_.category[i] != wanted || is_positive_[i] ||
-            drawn_before_[i] || labels_.max_iou[i] >= params_.obstacle_iou) {
+            labels_.max_iou[i] >= params_.obstacle_iou) {
           continue;
         }
         (proposals_[i].score > params_.hard_objectness ? hard : easy).push_back(i);
@@ -236,17 +214,16 @@ class NegativeSampler {
           DrawNegatives(hard, easy, counts[k], params_.hard_fraction, rng_);
       negatives.insert(negatives.end(), drawn.begin(), drawn.end());
     }
-    for (const int i : negatives) drawn_before_[i] = 1;
     return negatives;
   }
 
+ private:
   const std::vector<ScoredBox>& proposals_;
   const ProposalLabels& labels_;
   const int num_ranges_;
   const SampleSelectionParams& params_;
   std::mt19937_64 rng_;
   std::vector<char> is_positive_;
-  std::vector<char> drawn_before_;
 };
 
 }  // namespace
@@ -287,12 +264,9 @@ Result<SelectedSamples> SelectTrainingSamples(const std::vector<ScoredBox>& prop
                                          : ProposalCategory::kBackground;
   NegativeSampler sampler(proposals, labels, out.positive_indices,
                           static_cast<int>(range_limits.size()) - 1, params, seed);
-  const std::size_t positives = out.positive_indices.size();
-  assemble(
-      sampler.DrawBags(ProposalCategory::kRoad, params.ordr_negatives, positives, out.ordr_bags),
-      out.ordr_indices, out.ordr_targets);
-  assemble(sampler.DrawBags(obdr_pool, params.obdr_negatives, positives, out.obdr_bags),
-           out.obdr_indices, out.obdr_targets);
+  assemble(sampler.Draw(ProposalCategory::kRoad, params.ordr_negatives), out.ordr_indices,
+           out.ordr_targets);
+  assemble(sampler.Draw(obdr_pool, params.obdr_negatives), out.obdr_indices, out.obdr_targets);
   return out;
 }
 

@@ -14,9 +14,6 @@
 
 namespace tod {
 
-// Upper bound on SampleSelectionParams::negative_bags (each bag is one forest of a regressor).
-inline constexpr int kMaxNegativeBags = 64;
-
 struct SampleSelectionParams {
   std::vector<int> ordr_negatives{17, 17, 17, 17};  // n^-_k for ORDR, one per range [P]
   std::vector<int> obdr_negatives{25, 25, 25, 25};  // n^-_k for OBDR [P]
@@ -26,10 +23,6 @@ struct SampleSelectionParams {
   double obstacle_iou = 0.5;     // category (ii) when max mask IoU >= this; negatives need less
   double road_fraction = 0.5;    // category (i) when the road share of the box exceeds this
   bool box_iou_target = false;   // targets = max box-vs-box IoU instead of mask IoU (§6.4 flag)
-  // Balanced bagging (Chen, Liaw & Breiman 2004): this many disjoint draws of the negatives per
-  // frame, each of the counts above; every bag keeps the paper's ratio of negatives to
-  // positives, and a regressor is then the union of one forest per bag (1 = the paper's draw).
-  int negative_bags = 1;
 };
 
 enum class ProposalCategory { kRoad, kObstacle, kBackground };
@@ -60,10 +53,6 @@ struct SelectedSamples {
   std::vector<int> obdr_indices;
   std::vector<float> obdr_targets;
   std::vector<int> positive_indices;  // the shared positives (prefix of both lists above)
-  // Per entry of ordr_indices / obdr_indices: kEveryBag for a positive, else the bag
-  // (0 .. negative_bags - 1) whose draw holds that negative.
-  static constexpr int kEveryBag = -1;
-  std::vector<int> ordr_bags, obdr_bags;
 };
 
 // proposals: B^I of one training image in full-image coordinates with objectness scores.

@@ -60,18 +60,8 @@ double MappedRow(const ModelBundle& bundle, int width, int height, double row) {
 BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height) {
   BoxFeatureOptions options;
   options.vertical_edges = bundle.params.vertical_edge_feature;
-  options.orientation_entropy = bundle.params.orientation_entropy_feature;
   options.road_surround = bundle.params.road_surround_feature;
   const GroundPlaneFeatureParams& params = bundle.params.box_features;
-  if (params.ground_plane_size)
-    options.horizon_y = MappedRow(bundle, width, height, params.horizon_y);
-  return options;
-}
-
-OcclusionFeatureOptions OcclusionFeatureOptionsForFrame(const ModelBundle& bundle, int width,
-                                                        int height) {
-  OcclusionFeatureOptions options;
-  const GroundPlaneFeatureParams& params = bundle.params.occlusion_features;
   if (params.ground_plane_size)
     options.horizon_y = MappedRow(bundle, width, height, params.horizon_y);
   return options;

@@ -10,7 +10,6 @@
 // Regions are clipped to the frame.
 #pragma once
 
-#include "core/edges/occlusion_features.h"
 #include "core/features/box_features.h"
 #include "core/pipeline/model_bundle.h"
 
@@ -37,11 +36,5 @@ FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height)
 // The proposal features' options of a bundle for frames of a given size: the ground-plane
 // horizon (PipelineParams::box_features) mapped like the regions' rows.
 BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height);
-
-// The occlusion classifier's feature options of a bundle for frames of a given size: the
-// ground-plane horizon (PipelineParams::occlusion_features) mapped like the regions' rows.
-// crop_y stays 0: OcclusionFeaturesOnCrop (frame_stages.h) sets it to R1's first row.
-OcclusionFeatureOptions OcclusionFeatureOptionsForFrame(const ModelBundle& bundle, int width,
-                                                        int height);
 
 }  // namespace tod

@@ -16,16 +16,12 @@ namespace tod {
 
 using Clock = std::chrono::steady_clock;
 
-OcclusionFeatureOptions OcclusionFeaturesOnCrop(OcclusionFeatureOptions frame_options,
-                                                const OcclusionEdges& oaocc) {
-  frame_options.crop_y = oaocc.r1.y;
-  return frame_options;
-}
-
-Result<OcclusionEdges> ComputeOcclusionEdges(
-    const cv::Mat3b& image, const MultilayerRegions& regions, const EdgeSource& edges,
-    const OcclusionClassifier* classifier, const OcclusionFeatureOptions& occlusion_features,
-    const PipelineParams& params, bool enhance, StageTimer* timer, const FrameBudget* budget) {
+Result<OcclusionEdges> ComputeOcclusionEdges(const cv::Mat3b& image,
+                                             const MultilayerRegions& regions,
+                                             const EdgeSource& edges,
+                                             const OcclusionClassifier* classifier,
+                                             const PipelineParams& params, bool enhance,
+                                             StageTimer* timer, const FrameBudget* budget) {
   // Marks a stage boundary; true when the timer's check asks to stop here.
   auto mark = [timer](const char* stage) {
     if (timer != nullptr) timer->Mark(stage);
@@ -34,7 +30,7 @@ Result<OcclusionEdges> ComputeOcclusionEdges(
   OcclusionEdges out;
   out.r1 = ClipToImage(regions.layers.front(), image.cols, image.rows);
   out.crop = image(out.r1.rect());
-  out.base_edge = edges.Compute(out.crop, params.edge_screening);
+  out.base_edge = edges.Compute(out.crop);
   CorrectSampledPrior(out.base_edge, params.prior_correction.edge_odds);
   // §2.2 single pass: Ê(p) = n(p) E(p), n(p) = number of layers containing p. Each inner layer
   // adds the same map once more over its rectangle.
@@ -55,7 +51,6 @@ Result<OcclusionEdges> ComputeOcclusionEdges(
   if (mark("superpixels")) return out;
   if (classifier != nullptr) {
     const OcclusionPaintOptions paint{
-        .features = OcclusionFeaturesOnCrop(occlusion_features, out),
         .screening = params.occlusion_screening,
         .deadline = budget != nullptr ? budget->OcclusionDeadline() : Clock::time_point::max()};
     Result<cv::Mat1f> occlusion =

@@ -32,25 +32,16 @@ struct OcclusionEdges {
   bool occlusion_cut_short = false;
 };
 
-// The occlusion classifier's features on the crop `oaocc` holds: the frame's options
-// (OcclusionFeatureOptionsForFrame) with crop_y at R1's first row. ComputeOcclusionEdges paints
-// with these, and the trainer samples with them.
-OcclusionFeatureOptions OcclusionFeaturesOnCrop(OcclusionFeatureOptions frame_options,
-                                                const OcclusionEdges& oaocc);
-
 // enhance = false gives the plain (non obstacle-aware) variant used by the OLP baseline.
 // With a null classifier only E, Ê and the superpixels are computed (training of the classifier).
-// `occlusion_features` are the classifier's (OcclusionFeatureOptionsForFrame; crop_y is set here,
-// OcclusionFeaturesOnCrop).
 // When the timer asks to stop at a stage boundary the maps computed so far are returned and the
 // caller reads timer->stopped(); a stage that rejects its input is an error naming the stage.
 // With a frame budget the occlusion classifier walks its trees until the budget's
 // OcclusionDeadline (asked when the stage starts).
 Result<OcclusionEdges> ComputeOcclusionEdges(
     const cv::Mat3b& image, const MultilayerRegions& regions, const EdgeSource& edges,
-    const OcclusionClassifier* classifier, const OcclusionFeatureOptions& occlusion_features,
-    const PipelineParams& params, bool enhance, StageTimer* timer = nullptr,
-    const FrameBudget* budget = nullptr);
+    const OcclusionClassifier* classifier, const PipelineParams& params, bool enhance,
+    StageTimer* timer = nullptr, const FrameBudget* budget = nullptr);
 
 // Region k's occlusion edge map (un-normalised): the R1 map cropped to R_k, with the artificial
 // frame edges along the crop border removed for k >= 2 (§3.2(4)). k is 0-based here.

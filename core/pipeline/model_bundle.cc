@@ -6,6 +6,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "core/base/atomic_file.h"
@@ -13,6 +14,7 @@
 #include "core/base/checksum.h"
 #include "core/features/box_features.h"
 #include "core/pipeline/json_integers.h"
+#include "core/pipeline/removed_options.h"
 
 namespace tod {
 namespace fs = std::filesystem;
@@ -23,6 +25,7 @@ constexpr const char* kEdgesFile = "edges.bin";
 constexpr const char* kOcclusionFile = "occlusion.bin";
 constexpr const char* kOrdrFile = "ordr.bin";
 constexpr const char* kObdrFile = "obdr.bin";
+constexpr const char* kSedModelFile = "sed_model.yml.gz";
 
 // The manifest's checksum of a file ("fnv1a64"), as hex. Its basis is a digit short of FNV's
 // standard offset basis (14695981039346656037): every manifest written so far carries checksums
@@ -78,17 +81,21 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
     return Status::Ok();
   };
   Status st;
-  if (bundle.edge_kind == "pixel_forest") {
-    const auto* classifier = dynamic_cast<const PixelEdgeClassifier*>(bundle.edges.get());
-    if (classifier == nullptr)
-      return Status::InvalidArgument("pixel_forest bundle without classifier");
-    st = add(kEdgesFile, EncodeModel(*classifier));
-    if (!st.ok()) return st;
-  } else if (bundle.edge_kind == "sed") {
-    auto bytes = ReadFile(sed_model_source);
-    st = add("sed_model.yml.gz", bytes);
-    if (!st.ok()) return st;
+  switch (bundle.edge_kind) {
+    case EdgeKind::kPixelForest: {
+      const auto* classifier = dynamic_cast<const PixelEdgeClassifier*>(bundle.edges.get());
+      if (classifier == nullptr)
+        return Status::InvalidArgument("pixel_forest bundle without classifier");
+      st = add(kEdgesFile, EncodeModel(*classifier));
+      break;
+    }
+    case EdgeKind::kSed:
+      st = add(kSedModelFile, ReadFile(sed_model_source));
+      break;
+    case EdgeKind::kGradient:
+      break;  // nothing learned
   }
+  if (!st.ok()) return st;
   if ((st = add(kOcclusionFile, EncodeModel(bundle.occlusion))); !st.ok()) return st;
   if ((st = add(kOrdrFile, EncodeModel(bundle.ordr))); !st.ok()) return st;
   if ((st = add(kObdrFile, EncodeModel(bundle.obdr))); !st.ok()) return st;
@@ -97,8 +104,8 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   manifest["format_version"] = kBundleFormatVersion;
   manifest["version"] = bundle.version;
   manifest["created"] = bundle.created.empty() ? NowIso8601() : bundle.created;
-  manifest["edge_source"] = bundle.edge_kind;
-  if (bundle.edge_kind == "sed") manifest["sed_model_file"] = "sed_model.yml.gz";
+  manifest["edge_source"] = EnumString(bundle.edge_kind);
+  if (bundle.edge_kind == EdgeKind::kSed) manifest["sed_model_file"] = kSedModelFile;
   manifest["params"] = ToJson(bundle.params);
   manifest["regions"] = bundle.regions.ToJson();
   manifest["size_filter"] = bundle.size_filter.ToJson();
@@ -189,9 +196,15 @@ Status ReadManifestFields(const BundleFiles& files, ModelBundle& bundle) {
       return Status::FailedPrecondition(where + ": format_version " + std::to_string(*version) +
                                         ", this build reads " +
                                         std::to_string(kBundleFormatVersion));
+    if (Status st = RefuseRemovedOptions(manifest, where); !st.ok()) return st;
     bundle.version = manifest.value("version", "");
     bundle.created = manifest.value("created", "");
-    bundle.edge_kind = manifest.at("edge_source").get<std::string>();
+    const std::string edge_source = manifest.at("edge_source").get<std::string>();
+    const std::optional<EdgeKind> edge_kind = ParseEnum<EdgeKind>(edge_source);
+    if (!edge_kind)
+      return Status::InvalidArgument(where + ": unknown edge_source '" + edge_source + "' (" +
+                                     EnumNamesInWords<EdgeKind>() + ")");
+    bundle.edge_kind = *edge_kind;
     auto params = PipelineParamsFromJson(manifest.at("params"));
     if (!params.ok()) return Status::InvalidArgument(where + ": " + params.status().message());
     bundle.params = *params;
@@ -246,27 +259,27 @@ Status LoadOcclusionClassifier(const BundleFiles& files, ModelBundle& bundle) {
 
 // The base edge source the manifest names: the trained pixel forest, the gradient, or SED.
 Status LoadBaseEdgeSource(const BundleFiles& files, ModelBundle& bundle) {
-  if (bundle.edge_kind == "pixel_forest") {
-    auto loaded = files.Decoded<PixelEdgeClassifier>(kEdgesFile);
-    if (!loaded.ok()) return loaded.status();
-    bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*loaded));
-    return Status::Ok();
+  switch (bundle.edge_kind) {
+    case EdgeKind::kPixelForest: {
+      auto loaded = files.Decoded<PixelEdgeClassifier>(kEdgesFile);
+      if (!loaded.ok()) return loaded.status();
+      bundle.edges = std::make_shared<PixelEdgeClassifier>(std::move(*loaded));
+      return Status::Ok();
+    }
+    case EdgeKind::kGradient:
+      bundle.edges = CreateGradientEdgeSource(bundle.params.gradient_edges);
+      return Status::Ok();
+    case EdgeKind::kSed: {
+      bundle.sed_model_file = files.manifest.value("sed_model_file", kSedModelFile);
+      auto bytes = files.Checked(bundle.sed_model_file);
+      if (!bytes.ok()) return bytes.status();
+      auto sed = CreateSedEdgeSource((files.root / bundle.sed_model_file).string());
+      if (!sed.ok()) return sed.status();
+      bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
+      return Status::Ok();
+    }
   }
-  if (bundle.edge_kind == "gradient") {
-    bundle.edges = CreateGradientEdgeSource(bundle.params.gradient_edges);
-    return Status::Ok();
-  }
-  if (bundle.edge_kind == "sed") {
-    bundle.sed_model_file = files.manifest.value("sed_model_file", "sed_model.yml.gz");
-    auto bytes = files.Checked(bundle.sed_model_file);
-    if (!bytes.ok()) return bytes.status();
-    auto sed = CreateSedEdgeSource((files.root / bundle.sed_model_file).string());
-    if (!sed.ok()) return sed.status();
-    bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
-    return Status::Ok();
-  }
-  return Status::InvalidArgument(files.manifest_path + ": unknown edge_source '" +
-                                 bundle.edge_kind + "'");
+  return Status::Internal("unhandled edge kind");
 }
 
 }  // namespace

@@ -24,9 +24,9 @@ struct ModelBundle {
   PipelineParams params;
   MultilayerRegions regions;
   SizeFilter size_filter;
-  std::string edge_kind = "pixel_forest";  // "pixel_forest", "gradient", "sed"
+  EdgeKind edge_kind = EdgeKind::kPixelForest;
   std::shared_ptr<const EdgeSource> edges;
-  std::string sed_model_file;  // for "sed": file name inside the bundle
+  std::string sed_model_file;  // for kSed: file name inside the bundle
   OcclusionClassifier occlusion;
   RandomForest ordr;
   RandomForest obdr;
@@ -38,7 +38,7 @@ struct ModelBundle {
 
 // Writes `bundle` to `dir` atomically (temporary sibling directory, then rename; an existing
 // bundle at `dir` is replaced only once the new one is complete).
-// sed_model_source: path of the SED model file to copy in (only for edge_kind "sed").
+// sed_model_source: path of the SED model file to copy in (only for EdgeKind::kSed).
 Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
                        const std::string& sed_model_source = "");
 

@@ -97,12 +97,15 @@ ObstacleDetector::ObstacleDetector(ModelBundle bundle, std::string name)
   info_.format_version = kBundleFormatVersion;
   info_.created = bundle_.created;
   info_.trained_on = TrainedOn(bundle_.training);
-  info_.edge_source = bundle_.edge_kind;
-  info_.manifest = {
-      {"version", bundle_.version},          {"created", bundle_.created},
-      {"edge_source", bundle_.edge_kind},    {"params", ToJson(bundle_.params)},
-      {"regions", bundle_.regions.ToJson()}, {"size_filter", bundle_.size_filter.ToJson()},
-      {"training", bundle_.training},        {"eval", bundle_.eval}};
+  info_.edge_source = EnumString(bundle_.edge_kind);
+  info_.manifest = {{"version", bundle_.version},
+                    {"created", bundle_.created},
+                    {"edge_source", EnumString(bundle_.edge_kind)},
+                    {"params", ToJson(bundle_.params)},
+                    {"regions", bundle_.regions.ToJson()},
+                    {"size_filter", bundle_.size_filter.ToJson()},
+                    {"training", bundle_.training},
+                    {"eval", bundle_.eval}};
 }
 
 namespace {
@@ -158,9 +161,8 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   frame.geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
   const MultilayerRegions& regions = frame.geometry.regions;
   Result<OcclusionEdges> computed =
-      ComputeOcclusionEdges(bgr, regions, *bundle_.edges, &bundle_.occlusion,
-                            OcclusionFeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows),
-                            bundle_.params, /*enhance=*/true, &timer, &budget);
+      ComputeOcclusionEdges(bgr, regions, *bundle_.edges, &bundle_.occlusion, bundle_.params,
+                            /*enhance=*/true, &timer, &budget);
   if (!computed.ok()) return computed.status();
   if (!timer.stopped().ok()) return timer.stopped();
   frame.oaocc = std::move(computed).value();

@@ -5,6 +5,7 @@
 
 #include "core/features/box_features.h"
 #include "core/pipeline/json_integers.h"
+#include "core/pipeline/removed_options.h"
 
 namespace tod {
 
@@ -15,8 +16,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegionParams, num_layers, restar
                                                 margin_fraction, seed)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GradientEdgeParams, smooth_radius,
                                                 normalise_percentile)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StickySuperpixelParams, k, alpha, beta, iterations,
-                                                strip_rows)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StickySuperpixelParams, k, alpha, beta, iterations)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(EdgeBoxParams, alpha, beta, min_score, max_boxes,
                                                 edge_min_mag, edge_merge_thr, cluster_min_mag,
                                                 max_aspect_ratio, max_wide_aspect_ratio,
@@ -35,13 +35,16 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(GroundPlaneFeatureParams, ground
                                                 horizon_y)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(PipelineParams, regions, gradient_edges,
                                                 superpixels, boxes, multistride, size_filter,
-                                                region_merge_iou, prior_correction, edge_screening,
+                                                region_merge_iou, prior_correction,
                                                 occlusion_screening, obstacle_calibration, fusion,
-                                                probability_map, box_features, occlusion_features,
-                                                vertical_edge_feature, orientation_entropy_feature,
-                                                road_surround_feature)
+                                                probability_map, box_features,
+                                                vertical_edge_feature, road_surround_feature)
 
-nlohmann::json ToJson(const PipelineParams& params) { return params; }
+nlohmann::json ToJson(const PipelineParams& params) {
+  nlohmann::json j = params;
+  WriteRemovedParams(j);
+  return j;
+}
 
 void CorrectSampledPrior(cv::Mat1f& probability, double odds_scale) {
   if (odds_scale == 1.0) return;
@@ -78,24 +81,21 @@ Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j) {
       !(p.probability_map.isolation.surround >= 1 &&
         std::isfinite(p.probability_map.isolation.surround)) ||
       !(p.prior_correction.edge_odds > 0) || !(p.prior_correction.occlusion_odds > 0) ||
-      p.edge_screening.trees < 0 ||
-      !(p.edge_screening.final_at_most >= 0 && p.edge_screening.final_at_most < 1) ||
       p.occlusion_screening.trees < 0 ||
       !(p.occlusion_screening.final_at_most >= 0 && p.occlusion_screening.final_at_most < 1) ||
-      !std::isfinite(p.box_features.horizon_y) || !std::isfinite(p.occlusion_features.horizon_y))
+      !std::isfinite(p.box_features.horizon_y))
     return Status::InvalidArgument(
         "parameters out of range (regions.num_layers, superpixels.k, fusion.keep_ratio, "
         "probability_map.top_fraction, region_merge_iou in (0, 1], prior_correction > 0, "
         "probability_map.isolation: exponent >= 0, context_boxes >= 1, surround >= 1, "
-        "edge_screening / occlusion_screening: trees >= 0, final_at_most in [0, 1), "
-        "box_features.horizon_y and occlusion_features.horizon_y finite)");
+        "occlusion_screening: trees >= 0, final_at_most in [0, 1), box_features.horizon_y "
+        "finite)");
   return p;
 }
 
 int ProposalFeatureCount(const PipelineParams& params) {
   BoxFeatureOptions options;
   options.vertical_edges = params.vertical_edge_feature;
-  options.orientation_entropy = params.orientation_entropy_feature;
   options.road_surround = params.road_surround_feature;
   return NumBoxFeatures(options);
 }
@@ -103,7 +103,6 @@ int ProposalFeatureCount(const PipelineParams& params) {
 std::string ProposalFeatureSet(const PipelineParams& params) {
   std::string set = "the paper's 20";
   if (params.vertical_edge_feature) set += ", the vertical edge share";
-  if (params.orientation_entropy_feature) set += ", the orientation entropy";
   if (params.road_surround_feature) set += ", the surround unlike the road";
   return set;
 }

@@ -28,20 +28,17 @@ struct PriorCorrection {
   double occlusion_odds = 1.0;  // c of the occlusion classifier
 };
 
-// Sizes measured on the ground plane (ours; docs/method.md#ground-plane-box-features,
-// docs/findings.md#occlusion-size-features). With few
+// Sizes measured on the ground plane (ours; docs/method.md#ground-plane-box-features). With few
 // training frames the learned parts see obstacles at a few distances only, and a size in pixels
 // then says "as far as the training obstacles stood": a near obstacle, larger than any they saw,
 // looks like the large patches of road and background. On a flat road image lengths are
 // physical lengths times the distance below the horizon (the ground-plane size prior fits that
 // horizon), so with ground_plane_size a length is divided by d = row − horizon_y (at least 1 px)
 // and an area by d². horizon_y is in the training frame's pixels (frame_geometry.h maps it to
-// other frame sizes). Off: the paper's pixel sizes.
-//  - box_features: proposal features 10, 12 and 13 (§5: centre column, width and height over the
-//    image's) become (centre column − middle column) / d, w / d and h / d, d from the box's
-//    centre row: a lateral position and a size that every training obstacle informs.
-//  - occlusion_features: the occlusion classifier's boundary length, region areas and vertical
-//    order (occlusion_features.h), d from the boundary's mean row.
+// other frame sizes). Off: the paper's pixel sizes. Used by box_features: proposal features 10, 12
+// and 13 (§5: centre column, width and height over the image's) become (centre column − middle
+// column) / d, w / d and h / d, d from the box's centre row: a lateral position and a size that
+// every training obstacle informs.
 struct GroundPlaneFeatureParams {
   bool ground_plane_size = false;
   double horizon_y = 0.0;
@@ -56,7 +53,8 @@ struct PipelineParams {
   StickySuperpixelParams superpixels;
   // The paper's Edge Boxes parameters, except that refinement is narrowed to the 5000 best grid
   // local maxima per region: refining every scoring window does not fit the frame budget
-  // (docs/method.md#local-maxima-refinement; `tod train --refine-all` restores the paper's).
+  // (docs/method.md#local-maxima-refinement; `tod train --paper local_maxima_refinement` restores
+  // the paper's).
   EdgeBoxParams boxes = [] {
     EdgeBoxParams p;
     p.refine_local_maxima = true;
@@ -71,13 +69,6 @@ struct PipelineParams {
   // boxes: on real frames more layers then *lowered* recall (docs/method.md#cross-region-nms).
   float region_merge_iou = 0.75f;
   PriorCorrection prior_correction;
-  // Early exit in the pixel edge classifier (ours, off by default; EdgeScreening): e.g. {8, 0.02}
-  // lets a cell whose mean over the first 8 trees is at most 0.02 keep that mean (half the cells
-  // of a real frame). Measured on the dev folds with 32 trees, it cost more quality than the
-  // extra trees gave: the occlusion classifier reads the fine structure of the small edge
-  // values, which the first trees alone leave noisier (docs/findings.md#edge-screening).
-  // {0, 0}: every tree on every cell.
-  EdgeScreening edge_screening;
   // Early exit in the occlusion classifier (ours; OcclusionPaintOptions): a superpixel pair
   // whose mean over the first `trees` trees is at most `final_at_most` keeps it. {0, 0} (every
   // tree on every pair, the reference) here, so a bundle whose manifest predates it keeps its
@@ -87,17 +78,11 @@ struct PipelineParams {
   FusionParams fusion;
   ProbabilityMapParams probability_map;
   GroundPlaneFeatureParams box_features;
-  GroundPlaneFeatureParams occlusion_features;
   // Proposal feature 21, the share of a box's strong gradient on near-vertical edges (ours;
   // vertical_edges.h, docs/method.md#vertical-edge-feature). false, the default and the paper's 20
   // features, so a bundle whose manifest predates it keeps its regressors' rows; `tod train`
   // turns it on (TrainingDefaultParams).
   bool vertical_edge_feature = false;
-  // One more proposal feature after those (22nd, or 21st without vertical_edge_feature): the
-  // orientation entropy of a box's strong gradients (ours; vertical_edges.h,
-  // docs/findings.md#orientation-entropy-feature). false, the default, so a bundle whose
-  // manifest predates it keeps its regressors' rows.
-  bool orientation_entropy_feature = false;
   // One more proposal feature after those: how unlike the road just in front of the car a box's
   // surround is (ours; box_features.h, docs/method.md#road-surround-feature). false, the default,
   // so a bundle whose manifest predates it keeps its regressors' rows; `tod train` turns it on
@@ -106,7 +91,7 @@ struct PipelineParams {
 };
 
 // The proposal features the regressors of a bundle with these parameters read: how many (20 to
-// 23; box_features.h's NumBoxFeatures) and which, in words.
+// 22; box_features.h's NumBoxFeatures) and which, in words.
 int ProposalFeatureCount(const PipelineParams& params);
 std::string ProposalFeatureSet(const PipelineParams& params);
 
@@ -123,8 +108,11 @@ std::string ProposalFeatureSet(const PipelineParams& params);
 // feature (docs/method.md#vertical-edge-feature).
 PipelineParams TrainingDefaultParams();
 
+// Also writes the keys of removed parameters at their one remaining value (removed_options.h),
+// so a manifest reads as those written before their removal.
 nlohmann::json ToJson(const PipelineParams& params);
-// Missing keys keep their defaults; wrong types are an error naming the key.
+// Missing keys keep their defaults; wrong types are an error naming the key. The keys of removed
+// parameters are not read here (RefuseRemovedOptions checks them at load).
 Result<PipelineParams> PipelineParamsFromJson(const nlohmann::json& j);
 
 }  // namespace tod

@@ -15,10 +15,8 @@ FrameColourTables BuildFrameColourTables(const cv::Mat3b& image, const Box& r1,
   const cv::Point r1_origin(r1.x, r1.y);
   FrameColourTables tables;
   tables.colour = std::make_shared<const ColourIntegrals>(r1_bgr, r1_origin);
-  if (options.vertical_edges || options.orientation_entropy) {
-    tables.vertical = std::make_shared<const VerticalEdgeIntegrals>(
-        r1_bgr, r1_origin, VerticalEdgeParams{.orientation_tables = options.orientation_entropy});
-  }
+  if (options.vertical_edges)
+    tables.vertical = std::make_shared<const VerticalEdgeIntegrals>(r1_bgr, r1_origin);
   return tables;
 }
 

@@ -68,10 +68,6 @@ struct EdgeBoxStats {
   long long windows_refined = 0;          // of those, refined (all unless refine_limit)
   long long scorings = 0;                 // all scorings past the early exit, with refinement
   long long boxes_out = 0;                // after NMS / max_boxes
-  // Regions whose scan with a provisional score bar did not settle the result and were scanned
-  // again without it (window_scan.h); the counters above describe the scan that gave the result,
-  // except scorings, which counts both.
-  long long rescans = 0;
   // The deadline cut the scan short: column chunks never scanned and refinements skipped.
   bool truncated = false;
   long long columns_skipped = 0;

@@ -243,11 +243,10 @@ ScanGrid MakeScanGrid(const BoxScorer& scorer, const EdgeBoxParams& params,
   return grid;
 }
 
-// Pass 1: scores every grid window above `bar` (steps 4-6), column chunks on `threads` threads,
-// and returns the hits in grid order.
+// Pass 1: scores every grid window (steps 4-6), column chunks on `threads` threads, and returns
+// the hits (score at least min_score) in grid order.
 GridHits ScanColumns(const BoxScorer& scorer, const EdgeBoxParams& params, const ScanGrid& grid,
-                     const WindowAdmission* admission, float bar, int threads,
-                     EdgeBoxStats& stats) {
+                     const WindowAdmission* admission, int threads, EdgeBoxStats& stats) {
   const std::vector<GridColumn>& columns = grid.columns;
   const size_t column_chunks = (columns.size() + kColumnsPerChunk - 1) / kColumnsPerChunk;
   std::vector<ColumnChunk> scanned(column_chunks);
@@ -273,7 +272,7 @@ GridHits ScanColumns(const BoxScorer& scorer, const EdgeBoxParams& params, const
           }
           const size_t before = own.hits.size();
           out.windows += s.ScoreColumn(columns[i].x, shape.width, shape.height, shape.stride_y,
-                                       tops, bar, own.hits, &own.rows);
+                                       tops, /*bar=*/-1.f, own.hits, &own.rows);
           column_hits[i] = static_cast<int>(own.hits.size() - before);
         }
         out.end = own.hits.size();
@@ -286,11 +285,10 @@ GridHits ScanColumns(const BoxScorer& scorer, const EdgeBoxParams& params, const
 
 // Pass 2: refinement (step 7) of the best refine_limit local maxima (or every hit), in grid
 // order - neighbouring windows share cache lines, which matters more than anything an order by
-// score bounds could skip. Clears *settled when the bar may have removed a window the unbarred
-// scan would refine.
+// score bounds could skip.
 void RefineHits(const BoxScorer& scorer, const EdgeBoxParams& params,
-                const std::vector<GridColumn>& columns, float bar, int threads, GridHits& grid,
-                EdgeBoxStats& stats, bool* settled) {
+                const std::vector<GridColumn>& columns, int threads, GridHits& grid,
+                EdgeBoxStats& stats) {
   std::vector<ScoreWindow>& hits = grid.hits;
   // Local maxima first, so that refine_limit picks the best of them.
   std::vector<size_t> chosen;
@@ -300,10 +298,6 @@ void RefineHits(const BoxScorer& scorer, const EdgeBoxParams& params,
     chosen.resize(hits.size());
     std::iota(chosen.begin(), chosen.end(), size_t{0});
   }
-  // With a bar, the refined windows are those of the unbarred scan only if the bar removed
-  // none of them: when at least refine_limit local maxima remain (every removed window scores
-  // below every remaining one, and removing lower windows keeps the others' local maximality).
-  if (bar >= 0.f && chosen.size() < static_cast<size_t>(params.refine_limit)) *settled = false;
   chosen = BestByGridScore(hits, std::move(chosen), params.refine_limit);
   const size_t chunks = (chosen.size() + kRefinementsPerChunk - 1) / kRefinementsPerChunk;
   std::atomic<long long> refined_windows{0};
@@ -321,59 +315,20 @@ void RefineHits(const BoxScorer& scorer, const EdgeBoxParams& params,
   }
 }
 
-// One scan of the grid, refinement and NMS (step 8), keeping only grid windows that score above
-// `bar` (all with at least min_score when bar < 0). Sets *settled to whether the result is the
-// one the scan without a bar gives (always when bar < 0), see ScanWindowGrid.
-std::vector<ScoredBox> ScanWithBar(const BoxScorer& scorer, const EdgeBoxParams& params,
-                                   EdgeBoxStats& stats, const WindowAdmission* admission, float bar,
-                                   bool* settled) {
+}  // namespace
+
+// One scan of the grid (steps 4-6), refinement (step 7) and NMS (step 8).
+std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxParams& params,
+                                      EdgeBoxStats& stats, const WindowAdmission* admission) {
   const int threads = ResolveThreadCount(params.threads);
   const ScanGrid grid = MakeScanGrid(scorer, params, admission);
-  GridHits hits = ScanColumns(scorer, params, grid, admission, bar, threads, stats);
-  if (params.refine) RefineHits(scorer, params, grid.columns, bar, threads, hits, stats, settled);
+  GridHits hits = ScanColumns(scorer, params, grid, admission, threads, stats);
+  if (params.refine) RefineHits(scorer, params, grid.columns, threads, hits, stats);
   std::vector<ScoredBox> boxes;
   boxes.reserve(hits.hits.size());
   for (const ScoreWindow& w : hits.hits) boxes.push_back(ScoredBox{ToBox(w), w.score});
   hits = {};
-  std::vector<ScoredBox> kept =
-      NonMaximumSuppression(std::move(boxes), params.beta, params.max_boxes);
-  // NMS takes boxes by descending score and stops at max_boxes: when it filled up, it never
-  // reached the boxes the bar removed (all of which score below every box it saw).
-  if (bar >= 0.f && kept.size() < static_cast<size_t>(params.max_boxes)) *settled = false;
-  return kept;
-}
-
-}  // namespace
-
-std::vector<ScoredBox> ScanWindowGrid(const BoxScorer& scorer, const EdgeBoxParams& params,
-                                      EdgeBoxStats& stats, const WindowAdmission* admission,
-                                      float provisional_bar) {
-  // Most walks run for windows that score far below the last box NMS keeps (max_boxes of them).
-  // The provisional scan skips those (the containment bound and the early exit reject many more
-  // windows, and walks stop sooner). It settles only where NMS fills max_boxes: on the synthetic
-  // frames of an earlier synthetic-trained model (last box 2-3.3 x min_score) every region did,
-  // on real frames with real-trained models almost none does (window_scan.h). A small grid is
-  // unlikely to fill max_boxes at all, and a scan that does not settle is wasted: such grids
-  // skip it.
-  const bool bar_applies =
-      provisional_bar > 1.f && params.max_boxes > 0 &&
-      CountWindows(scorer.width(), scorer.height(), params) >=
-          kMinGridWindowsPerBox * params.max_boxes &&
-      (!params.refine || (params.refine_local_maxima && params.refine_limit > 0));
-  if (bar_applies) {
-    const EdgeBoxStats before = stats;
-    bool settled = true;
-    std::vector<ScoredBox> kept =
-        ScanWithBar(scorer, params, stats, admission, provisional_bar * params.min_score, &settled);
-    // A scan the deadline cut short is the result: there is no time for a second one.
-    if (settled || stats.truncated) return kept;
-    const long long provisional_scorings = stats.scorings - before.scorings;
-    stats = before;
-    stats.rescans += 1;
-    stats.scorings += provisional_scorings;
-  }
-  bool settled = true;
-  return ScanWithBar(scorer, params, stats, admission, -1.f, &settled);
+  return NonMaximumSuppression(std::move(boxes), params.beta, params.max_boxes);
 }
 
 }  // namespace tod

@@ -51,7 +51,7 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
                             {"trained", true},
                             {"fit", run.options().fit_map_isolation},
                             {"folds", kFolds},
-                            {"fold_layout", FoldLayoutName(run.options().fold_layout)}};
+                            {"fold_layout", kFoldLayoutName}};
   parts["map_isolation"].update(isolation.ToJson());
   run.Say("map isolation exponent " + std::to_string(isolation.exponent(chosen)));
 
@@ -70,7 +70,7 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
     parts["calibration"] = {{"learned", true},
                             {"trained", false},
                             {"reason", fitted.status().message()},
-                            {"fold_layout", FoldLayoutName(run.options().fold_layout)},
+                            {"fold_layout", kFoldLayoutName},
                             {"components", evidence.size()}};
     return Status::Ok();
   }
@@ -78,7 +78,7 @@ Status CalibrateObstacleScores(TrainingRun& run, const Survey& survey,
   parts["calibration"] = {{"learned", true},
                           {"trained", true},
                           {"folds", kFolds},
-                          {"fold_layout", FoldLayoutName(run.options().fold_layout)},
+                          {"fold_layout", kFoldLayoutName},
                           {"components", fitted->samples},
                           {"on_obstacles", fitted->positives},
                           {"flat", fitted->flat}};

@@ -6,13 +6,14 @@
 #include "core/edges/edge_labels.h"
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
+#include "core/training/trainer.h"
 
 namespace tod::training {
 namespace {
 
 constexpr char kFewFramesHint[] =
     "out-of-fold maps train each classifier again on each half of the classifier frames; with "
-    "few frames, --in-sample-maps trains without the halves";
+    "few frames, --paper out_of_fold_maps trains without the halves";
 
 // Trains the fold copies of a classifier (nothing when folds are off): fit(frames of fold f,
 // name) for each fold f, then install(upstream bundle of fold f, the copy).
@@ -45,28 +46,30 @@ std::vector<int> ClassifierFrames(const TrainingRun& run, const Survey& survey) 
     out.push_back(survey.usable[j]);
   return out;
 }
+
 // §3.4 step 1: the base edge source. Samples are extracted frame by frame.
 Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
                        ClassifierFolds& folds, nlohmann::json& parts) {
   const TrainOptions& options = run.options();
   bundle.edge_kind = options.edge_source;
-  if (options.edge_source == "gradient") {
-    bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
-    parts["edges"] = {{"kind", "gradient"}, {"learned", false}};
-    ShareUnlearnedEdges(bundle, folds);
-    return Status::Ok();
+  switch (options.edge_source) {
+    case EdgeKind::kGradient:
+      bundle.edges = CreateGradientEdgeSource(options.params.gradient_edges);
+      parts["edges"] = {{"kind", EnumString(EdgeKind::kGradient)}, {"learned", false}};
+      ShareUnlearnedEdges(bundle, folds);
+      return Status::Ok();
+    case EdgeKind::kSed: {
+      auto sed = CreateSedEdgeSource(options.sed_model);
+      if (!sed.ok()) return sed.status().WithContext("loading the SED edge model");
+      bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
+      parts["edges"] = {
+          {"kind", EnumString(EdgeKind::kSed)}, {"learned", false}, {"model", options.sed_model}};
+      ShareUnlearnedEdges(bundle, folds);
+      return Status::Ok();
+    }
+    case EdgeKind::kPixelForest:
+      break;  // trained below
   }
-  if (options.edge_source == "sed") {
-    auto sed = CreateSedEdgeSource(options.sed_model);
-    if (!sed.ok()) return sed.status().WithContext("loading the SED edge model");
-    bundle.edges = std::shared_ptr<const EdgeSource>(std::move(*sed));
-    parts["edges"] = {{"kind", "sed"}, {"learned", false}, {"model", options.sed_model}};
-    ShareUnlearnedEdges(bundle, folds);
-    return Status::Ok();
-  }
-  if (options.edge_source != "pixel_forest")
-    return Status::InvalidArgument("unknown edge source '" + options.edge_source +
-                                   "' (pixel_forest, gradient, sed)");
   const std::vector<int> which = ClassifierFrames(run, survey);
   PixelEdgeParams edge_params = options.edge_params;
   edge_params.forest.seed = options.seed;
@@ -99,7 +102,7 @@ Status TrainEdgeSource(TrainingRun& run, const Survey& survey, ModelBundle& bund
     return options.prior_correction ? c.sampled_odds_scale() : 1.0;
   };
   bundle.params.prior_correction.edge_odds = odds(*classifier);
-  parts["edges"] = {{"kind", "pixel_forest"},
+  parts["edges"] = {{"kind", EnumString(EdgeKind::kPixelForest)},
                     {"learned", true},
                     {"trained", true},
                     {"frames", which.size()},
@@ -129,13 +132,11 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
   const Status st = run.FirstError(which, run.ForEachFrame(which, [&](int i, const Sample& s) {
     const ModelBundle& upstream = folds.For(bundle, i);
     const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-        s.image, bundle.regions, *upstream.edges, nullptr, {}, upstream.params, /*enhance=*/true);
+        s.image, bundle.regions, *upstream.edges, nullptr, upstream.params, /*enhance=*/true);
     if (!computed.ok()) return computed.status();
     const OcclusionEdges& oaocc = *computed;
-    const OcclusionTrainingFrame frame{
-        oaocc.crop, oaocc.enhanced, oaocc.superpixels, LabelMap(s)(oaocc.r1.rect()).clone(),
-        OcclusionFeaturesOnCrop(OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows),
-                                oaocc)};
+    const OcclusionTrainingFrame frame{oaocc.crop, oaocc.enhanced, oaocc.superpixels,
+                                       LabelMap(s)(oaocc.r1.rect()).clone()};
     auto samples = ExtractOcclusionSamples(frame, params, static_cast<std::size_t>(i));
     if (!samples.ok()) return samples.status();
     per_frame[i] = std::move(*samples);
@@ -172,7 +173,7 @@ Status TrainOcclusionClassifier(TrainingRun& run, const Survey& survey, ModelBun
                         {"frames", which.size()},
                         {"contour_pairs", positives},
                         {"edge_maps", folds.enabled ? "out_of_fold" : "in_sample"},
-                        {"fold_layout", FoldLayoutName(options.fold_layout)},
+                        {"fold_layout", kFoldLayoutName},
                         {"prior_odds", bundle.params.prior_correction.occlusion_odds},
                         {"trees", params.forest.num_trees},
                         {"negatives_per_positive", params.negatives_per_positive}};

@@ -23,7 +23,7 @@ std::vector<int> ClassifierFrames(const TrainingRun& run, const Survey& survey);
 // features) learns from the wrong distribution. Stacked training: each learned part also gets a
 // copy trained on each of two folds of frames, and a frame's maps for the next part come from the
 // copy trained on the other fold, as they would on a frame never seen. The folds are runs of
-// whole drives by default (TrainOptions::fold_layout, training_folds.h).
+// whole drives (training_folds.h).
 constexpr int kFolds = 2;
 
 struct ClassifierFolds {
@@ -33,10 +33,8 @@ struct ClassifierFolds {
   std::array<ModelBundle, kFolds> upstream;
 
   ClassifierFolds(bool on, int num_frames, const std::vector<int>& usable,
-                  const std::vector<int>& classifier_frames, FoldLayout layout,
                   const std::vector<int>& source)
-      : enabled(on),
-        fold_of(AssignFolds(num_frames, usable, classifier_frames, kFolds, layout, source)) {}
+      : enabled(on), fold_of(AssignFolds(num_frames, usable, kFolds, source)) {}
   int FoldOf(int frame) const { return fold_of[frame]; }
   // The bundle whose classifiers compute frame `i`'s maps for a downstream part.
   const ModelBundle& For(const ModelBundle& bundle, int frame) const {

@@ -4,7 +4,6 @@
 #include <atomic>
 #include <string>
 
-#include "core/data/pasted_obstacles.h"
 #include "core/features/mask_iou.h"
 #include "core/features/sample_selection.h"
 #include "core/pipeline/frame_geometry.h"
@@ -28,26 +27,15 @@ ProposalSet Subset(const ProposalSet& all, const std::vector<int>& indices) {
   return out;
 }
 
-// The regressors' rows of one frame, real or with pasted obstacles.
+// The regressors' rows of one frame.
 struct FrameRows {
   cv::Mat1f ordr, obdr;
   std::vector<float> ordr_targets, obdr_targets;
-  std::vector<int> ordr_bags, obdr_bags;
   long long proposals = 0;
-
-  // Appends the rows of `more` (a pasted copy: its proposals are not counted).
-  void Append(const FrameRows& more) {
-    ordr.push_back(more.ordr);
-    obdr.push_back(more.obdr);
-    ordr_targets.insert(ordr_targets.end(), more.ordr_targets.begin(), more.ordr_targets.end());
-    obdr_targets.insert(obdr_targets.end(), more.obdr_targets.begin(), more.obdr_targets.end());
-    ordr_bags.insert(ordr_bags.end(), more.ordr_bags.begin(), more.ordr_bags.end());
-    obdr_bags.insert(obdr_bags.end(), more.obdr_bags.begin(), more.obdr_bags.end());
-  }
 };
 
 // The rows of the own boxes `truth` (features `x`, one row each), appended to both regressors'
-// rows as positives of every bag, with the targets the selection gives (mask IoU, or box IoU with
+// rows as positives, with the targets the selection gives (mask IoU, or box IoU with
 // SampleSelectionParams::box_iou_target).
 Status AppendTruthRows(const Sample& s, const ProposalSet& truth, const cv::Mat1f& x,
                        const SampleSelectionParams& selection, FrameRows& rows) {
@@ -59,8 +47,6 @@ Status AppendTruthRows(const Sample& s, const ProposalSet& truth, const cv::Mat1
                                                                      : table->MaxIoU(b.box));
     rows.ordr_targets.push_back(target);
     rows.obdr_targets.push_back(target);
-    rows.ordr_bags.push_back(SelectedSamples::kEveryBag);
-    rows.obdr_bags.push_back(SelectedSamples::kEveryBag);
   }
   rows.ordr.push_back(x);
   rows.obdr.push_back(x);
@@ -78,16 +64,13 @@ cv::Mat1f PickRows(const cv::Mat1f& measured, const std::vector<int>& indices,
 }
 
 // §6 on one frame: its proposals (maps by `upstream`'s classifiers), ranked by objectness or, with
-// `miner`, by the miner's fused score; the selected samples' features and targets. With
-// `positives_only` (a pasted copy: its negatives would be the frame's road again) the negatives
-// are dropped before any feature is computed.
+// `miner`, by the miner's fused score; the selected samples' features and targets.
 Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundle,
                                        const ModelBundle& upstream, const ModelBundle* miner,
                                        const SampleSelectionParams& selection, std::uint64_t seed,
-                                       bool positives_only, bool truth_boxes) {
+                                       bool truth_boxes) {
   const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-      s.image, bundle.regions, *upstream.edges, &upstream.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, s.image.cols, s.image.rows), upstream.params, true);
+      s.image, bundle.regions, *upstream.edges, &upstream.occlusion, upstream.params, true);
   if (!computed.ok()) return computed.status();
   const OcclusionEdges& oaocc = *computed;
   const ProposalSet all = ProposeBoxes(
@@ -101,15 +84,6 @@ Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundl
   }
   auto selected = SelectTrainingSamples(ranked, s, bundle.regions.RangeLimits(), selection, seed);
   if (!selected.ok()) return selected.status();
-  if (positives_only) {
-    // Positives come first in both lists, shared (SelectedSamples).
-    const std::size_t p = selected->positive_indices.size();
-    for (std::vector<int>* v : {&selected->ordr_indices, &selected->obdr_indices,
-                                &selected->ordr_bags, &selected->obdr_bags})
-      v->resize(p);
-    selected->ordr_targets.resize(p);
-    selected->obdr_targets.resize(p);
-  }
   // The two selections share their positives and may share negatives: every distinct proposal
   // is measured once, beside the own boxes, on one set of R1's colour tables.
   std::vector<int> distinct = selected->ordr_indices;
@@ -136,28 +110,15 @@ Result<FrameRows> RegressorRowsOfFrame(const Sample& s, const ModelBundle& bundl
   rows.obdr = PickRows(x, selected->obdr_indices, row_of);
   rows.ordr_targets = std::move(selected->ordr_targets);
   rows.obdr_targets = std::move(selected->obdr_targets);
-  rows.ordr_bags = std::move(selected->ordr_bags);
-  rows.obdr_bags = std::move(selected->obdr_bags);
   rows.proposals = static_cast<long long>(all.boxes.size());
   const cv::Mat1f truth_rows = x.rowRange(static_cast<int>(distinct.size()), x.rows);
   if (Status st = AppendTruthRows(s, truth, truth_rows, selection, rows); !st.ok()) return st;
   return rows;
 }
 
-// The cut-outs frame `i` may be pasted with: those of the other frames of its fold, so that no
-// part trained on the other fold (out-of-fold maps, the calibration's regressors) sees them.
-std::vector<const ObstacleCutout*> DonorsFor(int i, const Survey& survey,
-                                             const ClassifierFolds& folds) {
-  std::vector<const ObstacleCutout*> donors;
-  for (const ObstacleCutout& c : survey.cutouts)
-    if (c.frame != i && folds.FoldOf(c.frame) == folds.FoldOf(i)) donors.push_back(&c);
-  return donors;
-}
-
 // With `miner` (a bundle with trained regressors), the negatives' "hard" share is drawn from the
 // proposals the miner's fused score puts above selection.hard_objectness instead of by
-// objectness (TrainOptions::mine_hard_negatives). With TrainOptions::pasted_copies, each frame's
-// rows are followed by those of its copies with pasted obstacles.
+// objectness (TrainOptions::mine_hard_negatives).
 Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey& survey,
                                                  const ModelBundle& bundle,
                                                  const ClassifierFolds& folds,
@@ -167,8 +128,6 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
   RegressorSamples out;
   out.ordr_rows.resize(n), out.obdr_rows.resize(n);
   out.ordr_targets.resize(n), out.obdr_targets.resize(n);
-  out.ordr_bags.resize(n), out.obdr_bags.resize(n);
-  out.num_bags = options.selection.negative_bags;
   std::vector<long long> proposals(n, 0);
   std::atomic<int> done{0};
   const Status st =
@@ -176,30 +135,14 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
         if (cv::countNonZero(s.road) > 0) {
           const ModelBundle& upstream = folds.For(bundle, i);
           const std::uint64_t seed = options.seed * 1000003ULL + static_cast<unsigned>(i);
-          auto rows = RegressorRowsOfFrame(s, bundle, upstream, miner, options.selection, seed,
-                                           /*positives_only=*/false, options.truth_box_positives);
+          auto rows = RegressorRowsOfFrame(s, bundle, upstream, miner, SampleSelectionParams{},
+                                           seed, options.truth_box_positives);
           if (!rows.ok()) return rows.status();
-          const std::vector<const ObstacleCutout*> donors =
-              options.pasted_copies > 0 ? DonorsFor(i, survey, folds)
-                                        : std::vector<const ObstacleCutout*>{};
-          for (int copy = 1; copy <= options.pasted_copies && !donors.empty(); ++copy) {
-            const std::uint64_t copy_seed = seed + 0x9E3779B97F4A7C15ULL * copy;
-            Sample pasted = PasteObstacles(s, donors, copy_seed, options.paste);
-            if (pasted.instances.size() == s.instances.size()) continue;  // no place was free
-            VoidOwnObstacles(pasted, s.instances.size());
-            auto more =
-                RegressorRowsOfFrame(pasted, bundle, upstream, miner, options.selection, copy_seed,
-                                     /*positives_only=*/true, options.truth_box_positives);
-            if (!more.ok()) return more.status().WithContext("pasted copy " + std::to_string(copy));
-            rows->Append(*more);
-          }
           proposals[i] = rows->proposals;
           out.ordr_rows[i] = std::move(rows->ordr);
           out.obdr_rows[i] = std::move(rows->obdr);
           out.ordr_targets[i] = std::move(rows->ordr_targets);
           out.obdr_targets[i] = std::move(rows->obdr_targets);
-          out.ordr_bags[i] = std::move(rows->ordr_bags);
-          out.obdr_bags[i] = std::move(rows->obdr_bags);
         }
         const int finished = ++done;
         if (finished % 10 == 0 || finished == static_cast<int>(survey.usable.size()))
@@ -211,43 +154,28 @@ Result<RegressorSamples> CollectRegressorSamples(TrainingRun& run, const Survey&
   for (long long c : proposals) out.proposals += c;
   return out;
 }
-// One regressor on the samples of the frames `in_fold(i)` accepts: with one bag the paper's
-// forest; with several (SampleSelectionParams::negative_bags) one forest per bag, on every
-// positive and that bag's negatives, with its share of the trees, joined into one forest.
-Result<RandomForest> FitBaggedRegressor(const std::vector<cv::Mat1f>& parts,
-                                        const std::vector<std::vector<float>>& targets,
-                                        const std::vector<std::vector<int>>& bags, int num_bags,
-                                        const std::function<bool(int)>& in_fold,
-                                        const ForestParams& forest, int& samples) {
+
+// One regressor (the paper's forest) on the samples of the frames `in_fold(i)` accepts.
+Result<RandomForest> FitRegressor(const std::vector<cv::Mat1f>& parts,
+                                  const std::vector<std::vector<float>>& targets,
+                                  const std::function<bool(int)>& in_fold,
+                                  const ForestParams& forest, int& samples) {
   constexpr int kMinSamples = 10;
-  std::vector<RandomForest> forests;
-  samples = 0;
-  for (int bag = 0; bag < num_bags; ++bag) {
-    cv::Mat1f x;
-    std::vector<float> y;
-    for (std::size_t i = 0; i < parts.size(); ++i) {
-      if (parts[i].empty() || !in_fold(static_cast<int>(i))) continue;
-      for (int r = 0; r < parts[i].rows; ++r) {
-        const int of = bags[i].empty() ? SelectedSamples::kEveryBag : bags[i][r];
-        if (of != SelectedSamples::kEveryBag && of != bag) continue;
-        x.push_back(parts[i].row(r));
-        y.push_back(targets[i][r]);
-        if (of == bag || bag == 0) ++samples;
-      }
+  cv::Mat1f x;
+  std::vector<float> y;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (parts[i].empty() || !in_fold(static_cast<int>(i))) continue;
+    for (int r = 0; r < parts[i].rows; ++r) {
+      x.push_back(parts[i].row(r));
+      y.push_back(targets[i][r]);
     }
-    if (x.rows < kMinSamples)
-      return Status::InvalidArgument(
-          "too few training samples (" + std::to_string(x.rows) + " in bag " + std::to_string(bag) +
-          ", need " + std::to_string(kMinSamples) + "); need frames with obstacles and free space");
-    ForestParams params = forest;
-    params.num_trees = forest.num_trees / num_bags + (bag < forest.num_trees % num_bags ? 1 : 0);
-    params.seed = forest.seed + 7919ULL * static_cast<std::uint64_t>(bag);
-    auto fitted = RandomForest::Fit(x, y, params);
-    if (!fitted.ok()) return fitted.status();
-    forests.push_back(std::move(*fitted));
   }
-  if (num_bags == 1) return std::move(forests.front());
-  return RandomForest::Join(forests);
+  samples = x.rows;
+  if (x.rows < kMinSamples)
+    return Status::InvalidArgument("too few training samples (" + std::to_string(x.rows) +
+                                   ", need " + std::to_string(kMinSamples) +
+                                   "); need frames with obstacles and free space");
+  return RandomForest::Fit(x, y, forest);
 }
 
 }  // namespace
@@ -256,12 +184,12 @@ Result<Regressors> TrainRegressorPair(const RegressorSamples& samples,
                                       const std::function<bool(int)>& in_fold,
                                       ForestParams forest) {
   Regressors out;
-  auto ordr = FitBaggedRegressor(samples.ordr_rows, samples.ordr_targets, samples.ordr_bags,
-                                 samples.num_bags, in_fold, forest, out.ordr_samples);
+  auto ordr =
+      FitRegressor(samples.ordr_rows, samples.ordr_targets, in_fold, forest, out.ordr_samples);
   if (!ordr.ok()) return ordr.status().WithContext("ORDR");
   forest.seed += 1;
-  auto obdr = FitBaggedRegressor(samples.obdr_rows, samples.obdr_targets, samples.obdr_bags,
-                                 samples.num_bags, in_fold, forest, out.obdr_samples);
+  auto obdr =
+      FitRegressor(samples.obdr_rows, samples.obdr_targets, in_fold, forest, out.obdr_samples);
   if (!obdr.ok()) return obdr.status().WithContext("OBDR");
   out.ordr = std::move(*ordr);
   out.obdr = std::move(*obdr);
@@ -269,7 +197,9 @@ Result<Regressors> TrainRegressorPair(const RegressorSamples& samples,
 }
 
 ForestParams RegressorForest(const TrainOptions& options) {
-  ForestParams forest = options.regressor;
+  // The Liaw-Wiener defaults: mtry 6 of 20, leaves of at least 5 samples (other values were
+  // measured and removed: docs/findings.md#regressor-mtry-min-leaf-and-hard-fraction).
+  ForestParams forest{.num_trees = options.regressor_trees, .max_features = 6, .min_leaf_size = 5};
   forest.seed = options.seed;
   forest.threads = options.threads;
   return forest;

@@ -18,9 +18,6 @@ namespace tod::training {
 struct RegressorSamples {
   std::vector<cv::Mat1f> ordr_rows, obdr_rows;
   std::vector<std::vector<float>> ordr_targets, obdr_targets;
-  // Per row: SelectedSamples::kEveryBag or the negative bag that drew it.
-  std::vector<std::vector<int>> ordr_bags, obdr_bags;
-  int num_bags = 1;
   long long proposals = 0;
 };
 

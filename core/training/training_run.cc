@@ -9,10 +9,9 @@
 namespace tod::training {
 
 Status TrainingRun::Open() {
-  std::vector<DatasetSpec> specs = {{options_.data_root, options_.split, options_.format,
-                                     options_.split_file, options_.max_frames}};
+  std::vector<DatasetSpec> specs = {options_.data.Spec()};
   for (const std::string& root : options_.more_data)
-    specs.push_back({root, options_.split, "auto", "", options_.max_frames});
+    specs.push_back({root, options_.data.split, "auto", "", options_.data.max_frames});
   auto selection = SelectFrames(specs);
   if (!selection.ok()) return selection.status();
   selection_ = std::move(*selection);
@@ -50,26 +49,21 @@ Status TrainingRun::FirstError(const std::vector<int>& which,
 
 Result<Survey> SurveyFrames(TrainingRun& run) {
   const int n = run.num_frames();
-  run.Say("surveying " + std::to_string(n) + " training frames from " + run.options().data_root);
+  run.Say("surveying " + std::to_string(n) + " training frames from " +
+          run.options().data.data_root);
   std::vector<int> all(n);
   for (int i = 0; i < n; ++i) all[i] = i;
   std::vector<cv::Size> sizes(n);
   std::vector<std::vector<ObstacleFootprint>> per_frame(n);
-  std::vector<std::vector<ObstacleCutout>> cutouts(n);
-  const bool cut_out = run.options().pasted_copies > 0;
   const std::vector<Status> statuses = run.ForEachFrame(all, [&](int i, const Sample& s) {
     sizes[i] = s.image.size();
-    for (const ObstacleInstance& inst : s.instances) {
+    for (const ObstacleInstance& inst : s.instances)
       per_frame[i].push_back({inst.box, inst.pixel_count()});
-      if (!cut_out) continue;
-      ObstacleCutout cutout = CutOutObstacle(s, inst, i, run.options().paste);
-      if (!cutout.patch.empty()) cutouts[i].push_back(std::move(cutout));
-    }
     return Status::Ok();
   });
   Survey survey;
   const Status bad = ApplyBadFramePolicy(
-      statuses, [&](int i) { return run.FrameName(i); }, run.options().on_bad_frame,
+      statuses, [&](int i) { return run.FrameName(i); }, run.options().data.on_bad_frame,
       &survey.skipped);
   if (!bad.ok()) return bad;
   for (const SkippedFrame& f : survey.skipped)
@@ -89,14 +83,10 @@ Result<Survey> SurveyFrames(TrainingRun& run) {
       survey.footprints.push_back(f);
       survey.obstacle_boxes.push_back(f.box);
     }
-    for (ObstacleCutout& c : cutouts[i]) survey.cutouts.push_back(std::move(c));
   }
   if (survey.usable.empty()) return Status::InvalidArgument("no usable training frame");
   run.Say(std::to_string(survey.footprints.size()) + " training obstacles in " +
           std::to_string(survey.usable.size()) + " frames");
-  if (cut_out)
-    run.Say(std::to_string(survey.cutouts.size()) +
-            " of them cut out to paste (the others have void or another obstacle in their ring)");
   return survey;
 }
 

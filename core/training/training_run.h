@@ -13,7 +13,7 @@
 #include "core/base/types.h"
 #include "core/datasets/bad_frames.h"
 #include "core/datasets/dataset_factory.h"
-#include "core/training/trainer.h"
+#include "core/training/train_options.h"
 
 namespace tod::training {
 
@@ -70,10 +70,9 @@ struct Survey {
   std::vector<Box> obstacle_boxes;
   std::vector<int> usable;  // positions of the frames every later step visits
   std::vector<SkippedFrame> skipped;
-  std::vector<ObstacleCutout> cutouts;  // of the usable frames, with TrainOptions::pasted_copies
 };
 
-// The first pass: every frame's size and obstacles (and cut-outs to paste); frames that cannot
+// The first pass: every frame's size and obstacles; frames that cannot
 // be read are skipped or fail the run (TrainOptions::on_bad_frame); all must share one size.
 Result<Survey> SurveyFrames(TrainingRun& run);
 

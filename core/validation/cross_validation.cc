@@ -42,17 +42,17 @@ std::string FoldSplitFile(const std::vector<CvFold>& folds, std::size_t k) {
 // The stems of every frame of the recipe's dataset (its split file's listed ones, if any).
 Result<std::vector<std::string>> AllStems(const TrainOptions& recipe) {
   DatasetSpec spec;
-  spec.root = recipe.data_root;
-  spec.format = recipe.format;
+  spec.root = recipe.data.data_root;
+  spec.format = recipe.data.format;
   spec.split = "all";
-  spec.split_file = recipe.split_file;
+  spec.split_file = recipe.data.split_file;
   auto selection = SelectFrames(spec);
   if (!selection.ok()) return selection.status();
   if (selection->format != "masks")
     return Status::InvalidArgument(
         "cross-validation needs a dataset in the masks layout (images/ + labels_masks/), whose "
         "folds it writes as split files; " +
-        recipe.data_root + " is " + selection->format);
+        recipe.data.data_root + " is " + selection->format);
   std::vector<std::string> stems;
   for (int i : selection->frames) stems.push_back(selection->dataset->name(i));
   return stems;
@@ -67,8 +67,8 @@ Result<nlohmann::json> RunFold(const TrainOptions& recipe, const EvalOptions& ev
                                const CrossValidationOptions& options, const std::string& split,
                                const std::string& model_dir, std::uint64_t seed) {
   TrainOptions train = recipe;
-  train.split = "train";
-  train.split_file = split;
+  train.data.split = "train";
+  train.data.split_file = split;
   train.seed = seed;
   auto bundle = TrainModel(train);
   if (!bundle.ok()) return bundle.status();
@@ -76,10 +76,9 @@ Result<nlohmann::json> RunFold(const TrainOptions& recipe, const EvalOptions& ev
     if (Status st = SaveModelBundle(*bundle, model_dir, recipe.sed_model); !st.ok()) return st;
   }
   EvalOptions test = eval;
-  test.data_root = recipe.data_root;
-  test.format = recipe.format;
-  test.split = "test";
-  test.split_file = split;
+  test.data = recipe.data;
+  test.data.split = "test";
+  test.data.split_file = split;
   auto report = EvaluateModel(*bundle, test);
   if (!report.ok()) return report.status();
   return EvalReportToJson(*report);

@@ -53,7 +53,6 @@ void Add(Totals& t, const tod::EdgeBoxStats& s, long long kept) {
   t.stats.windows_past_early_exit += s.windows_past_early_exit;
   t.stats.windows_refined += s.windows_refined;
   t.stats.scorings += s.scorings;
-  t.stats.rescans += s.rescans;
   t.kept += kept;
 }
 
@@ -87,21 +86,20 @@ RegionRun ScoreRegion(const cv::Mat1f& map, const tod::EdgeBoxParams& params,
 
 // The configurations side by side: median ms, speed-up over the paper's, counts per frame.
 void PrintConfigTable(const std::vector<Config>& configs, const std::vector<Totals>& totals,
-                      const tod::SynthParams& synth, int frames, int layers) {
+                      const tod::SynthParams& synth, int frames) {
   std::printf("frame %dx%d, %d frames, one core; counts per frame (mean), times median\n",
               synth.width, synth.height, frames);
   std::printf(
-      "| configuration | ms | vs paper | windows scored | walks | refined | kept boxes | rescanned "
-      "regions | digest |\n"
-      "|---|---|---|---|---|---|---|---|---|\n");
+      "| configuration | ms | vs paper | windows scored | walks | refined | kept boxes | digest |\n"
+      "|---|---|---|---|---|---|---|---|\n");
   const double paper_ms = Median(totals[0].ms);
   for (size_t c = 0; c < configs.size(); ++c) {
     const Totals& t = totals[c];
     const double ms = Median(t.ms);
-    std::printf("| %s | %.1f | %.2fx | %lld | %lld | %lld | %lld | %lld of %d | %016llx |\n",
+    std::printf("| %s | %.1f | %.2fx | %lld | %lld | %lld | %lld | %016llx |\n",
                 configs[c].name.c_str(), ms, ms > 0 ? paper_ms / ms : 0.0,
                 t.stats.windows_visited / frames, t.stats.scorings / frames,
-                t.stats.windows_refined / frames, t.kept / frames, t.stats.rescans, frames * layers,
+                t.stats.windows_refined / frames, t.kept / frames,
                 static_cast<unsigned long long>(t.digest));
   }
 }
@@ -159,9 +157,7 @@ int main(int argc, char** argv) {
   for (int f = 0; f < frames; ++f) {
     const tod::Sample frame = tod::GenerateSynthFrame(synth, 1000 + static_cast<unsigned>(f), "b");
     const tod::Result<tod::OcclusionEdges> computed = tod::ComputeOcclusionEdges(
-        frame.image, geometry.regions, *bundle->edges, &bundle->occlusion,
-        tod::OcclusionFeatureOptionsForFrame(*bundle, frame.image.cols, frame.image.rows),
-        bundle->params, true);
+        frame.image, geometry.regions, *bundle->edges, &bundle->occlusion, bundle->params, true);
     if (!computed.ok()) {
       std::cerr << computed.status().ToString() << "\n";
       return 1;
@@ -195,7 +191,7 @@ int main(int argc, char** argv) {
     }
     for (size_t c = 0; c < configs.size(); ++c) config_totals[c].ms.push_back(frame_ms[c]);
   }
-  PrintConfigTable(configs, config_totals, synth, frames, layers);
+  PrintConfigTable(configs, config_totals, synth, frames);
   PrintRegionTable(configs.back().name, region_totals, region_sizes, bundle->params.multistride,
                    frames);
   return 0;

@@ -228,8 +228,7 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
   EXPECT_NE(run.output.find("paper's map: "), std::string::npos) << run.output;
   // And which features the regressors read.
   int features = 20;
-  for (const char* optional :
-       {"vertical_edge_feature", "orientation_entropy_feature", "road_surround_feature"})
+  for (const char* optional : {"vertical_edge_feature", "road_surround_feature"})
     features += manifest["params"].value(optional, false) ? 1 : 0;
   EXPECT_EQ(j["proposal_features"], features);
   EXPECT_NE(run.output.find("regressors: " + j["proposal_features"].dump() + " proposal features"),

@@ -28,9 +28,9 @@ TEST(Modd2Cli, TrainAndEvalOnMarineScenes) {
   // 4 sequences (1 train, 3 test by the synthetic split), 8 frames each, 480 x 360.
   ASSERT_TRUE(tod::WriteModd2SynthDataset((dir / "modd2").string(), 4, 8, 480, 360, 11).ok());
   const std::string tod = tod::testing_env::BinDir() + "/tod";
-  auto [code, out] =
-      Shell(tod + " train --data " + (dir / "modd2").string() + " --format modd2 --out " +
-            (dir / "model").string() + " --seed 3 --trees 20 --no-eval --refine-all");
+  auto [code, out] = Shell(tod + " train --data " + (dir / "modd2").string() +
+                           " --format modd2 --out " + (dir / "model").string() +
+                           " --seed 3 --trees 20 --no-eval --paper local_maxima_refinement");
   ASSERT_EQ(code, 0) << out;
   std::ifstream manifest_in(dir / "model" / "manifest.json");
   const nlohmann::json manifest = nlohmann::json::parse(manifest_in);
@@ -38,7 +38,8 @@ TEST(Modd2Cli, TrainAndEvalOnMarineScenes) {
   EXPECT_EQ(manifest["regions"]["image_width"], 480);
   EXPECT_EQ(manifest["regions"]["image_height"], 360);
   EXPECT_EQ(manifest["training"]["format"], "modd2");
-  // --refine-all: the paper's refinement of every scoring window, recorded with the model.
+  // --paper local_maxima_refinement: the paper's refinement of every scoring window, recorded with
+  // the model.
   EXPECT_EQ(manifest["params"]["boxes"]["refine_local_maxima"], false);
   EXPECT_EQ(manifest["params"]["boxes"]["refine_limit"], 0);
 

@@ -20,7 +20,7 @@ TEST(GradientEdgeSource, StepEdgeMatchesHandComputedProfile) {
   cv::Mat3b image(64, 64, cv::Vec3b(0, 0, 0));
   image(cv::Rect(32, 0, 32, 64)).setTo(cv::Vec3b(255, 255, 255));
   const auto source = CreateGradientEdgeSource();
-  EXPECT_EQ(source->kind(), "gradient");
+  EXPECT_EQ(source->kind(), EdgeKind::kGradient);
   const cv::Mat1f edge = source->Compute(image);
   ASSERT_EQ(edge.size(), image.size());
   for (const int y : {0, 20, 63}) {

@@ -104,7 +104,7 @@ StripeScene RandomScene(int rows, int cols, int seed) {
 TEST(OcclusionFeaturesTest, PairsAreTheLabelsMeetingAtEachBoundaryPixel) {
   for (const cv::Size size : {cv::Size(97, 61), cv::Size(8, 3), cv::Size(1, 9), cv::Size(150, 2)}) {
     const StripeScene s = RandomScene(size.height, size.width, size.area());
-    const SuperpixelPairs got = ComputeSuperpixelPairs(s.image, s.edge, s.superpixels, {});
+    const SuperpixelPairs got = ComputeSuperpixelPairs(s.image, s.edge, s.superpixels);
     const cv::Mat1i& labels = s.superpixels.labels;
     std::set<std::pair<int, int>> expected_pairs;
     std::vector<int> expected_pixels;
@@ -152,7 +152,7 @@ TEST(OcclusionFeaturesTest, PairsAreTheLabelsMeetingAtEachBoundaryPixel) {
 
 TEST(OcclusionFeaturesTest, StripePairsByHand) {
   const StripeScene s = MakeStripes();
-  const SuperpixelPairs pairs = ComputeSuperpixelPairs(s.image, s.edge, s.superpixels, {});
+  const SuperpixelPairs pairs = ComputeSuperpixelPairs(s.image, s.edge, s.superpixels);
   ASSERT_EQ(pairs.pairs.size(), 2u);
   EXPECT_EQ(pairs.pairs[0], cv::Vec2i(1, 2));
   EXPECT_EQ(pairs.pairs[1], cv::Vec2i(2, 3));
@@ -187,51 +187,6 @@ TEST(OcclusionFeaturesTest, StripePairsByHand) {
   EXPECT_FLOAT_EQ(f23[kHueChi2], 0.f);
 }
 
-// Ground-plane sizes: lengths over d and areas over d², d = frame row of the boundary's mean −
-// horizon (at least 1); every other feature as in pixels.
-TEST(OcclusionFeaturesTest, GroundPlaneSizesDivideByTheRowsBelowTheHorizon) {
-  const StripeScene s = MakeStripes();
-  const SuperpixelPairs plain = ComputeSuperpixelPairs(s.image, s.edge, s.superpixels, {});
-  // The crop starts at frame row 2, so the boundary's mean row 1.5 is frame row 3.5: d = 14.
-  const SuperpixelPairs ground =
-      ComputeSuperpixelPairs(s.image, s.edge, s.superpixels, {.horizon_y = -10.5, .crop_y = 2});
-  ASSERT_EQ(ground.pairs, plain.pairs);
-  const float* f = ground.features[0];
-  EXPECT_FLOAT_EQ(f[kBoundaryLength], 4.f / 14.f);
-  EXPECT_FLOAT_EQ(f[kAreaSmaller], 8.f / 196.f);
-  EXPECT_FLOAT_EQ(f[kAreaLarger], 8.f / 196.f);
-  for (int c = 0; c < kNumOcclusionFeatures; ++c) {
-    if (c == kBoundaryLength || c == kAreaSmaller || c == kAreaLarger) continue;
-    EXPECT_EQ(f[c], plain.features(0, c)) << c;
-  }
-  // A boundary at or above the horizon divides by 1: pixel sizes.
-  const SuperpixelPairs above =
-      ComputeSuperpixelPairs(s.image, s.edge, s.superpixels, {.horizon_y = 100.0, .crop_y = 0});
-  EXPECT_FLOAT_EQ(above.features(0, kBoundaryLength), 4.f);
-  EXPECT_FLOAT_EQ(above.features(0, kAreaSmaller), 8.f);
-}
-
-// The vertical order (a length) goes from crop heights to rows below the horizon too.
-TEST(OcclusionFeaturesTest, GroundPlaneVerticalOrderIsALengthOverD) {
-  // Two rows of label 1 over a boundary row over three rows of label 2.
-  Superpixels sp;
-  sp.labels = cv::Mat1i(6, 4, 2);
-  sp.labels.rowRange(0, 2) = 1;
-  sp.labels.row(2) = 0;
-  sp.count = 2;
-  const cv::Mat3b image(6, 4, cv::Vec3b(90, 90, 90));
-  const cv::Mat1f edge(6, 4, 0.5f);
-  const SuperpixelPairs plain = ComputeSuperpixelPairs(image, edge, sp, {});
-  const SuperpixelPairs ground = ComputeSuperpixelPairs(image, edge, sp, {.horizon_y = -8.0});
-  ASSERT_EQ(plain.pairs.size(), 1u);
-  ASSERT_EQ(ground.pairs.size(), 1u);
-  // The smaller region (rows 0-1) sits above the larger one (rows 3-5): negative.
-  ASSERT_LT(plain.features(0, kVerticalOrder), 0.f);
-  const double d = plain.features(0, kBoundaryY) * 6.0 + 8.0;
-  EXPECT_NEAR(ground.features(0, kVerticalOrder), plain.features(0, kVerticalOrder) * 6.0 / d,
-              1e-6);
-}
-
 // Texture: two regions of vertical stripes (period 4) have identical orientation histograms
 // (all gradient in the horizontal bin); vertical against horizontal stripes are near-disjoint.
 TEST(OcclusionFeaturesTest, TextureDistanceSeparatesStripeOrientations) {
@@ -249,8 +204,8 @@ TEST(OcclusionFeaturesTest, TextureDistanceSeparatesStripeOrientations) {
       mixed(y, x) = x <= 10 ? cv::Vec3b(v, v, v) : cv::Vec3b(h, h, h);
     }
   const cv::Mat1f edge(12, 21, 0.f);
-  const SuperpixelPairs same = ComputeSuperpixelPairs(vertical, edge, sp, {});
-  const SuperpixelPairs different = ComputeSuperpixelPairs(mixed, edge, sp, {});
+  const SuperpixelPairs same = ComputeSuperpixelPairs(vertical, edge, sp);
+  const SuperpixelPairs different = ComputeSuperpixelPairs(mixed, edge, sp);
   ASSERT_EQ(same.pairs.size(), 1u);
   ASSERT_EQ(different.pairs.size(), 1u);
   EXPECT_FLOAT_EQ(same.features(0, kTextureChi2), 0.f);
@@ -450,14 +405,14 @@ TEST_F(TrainedOcclusionTest, PaintIsTheSameOnOneThreadAndOnSeveral) {
       if (x % 5 != 4 && y % 5 != 4) grid.labels(y, x) = 1 + (y / 5) * cols + x / 5;
   grid.count = cols * (image.rows / 5);
   // Enough pairs for three pieces of the walk (2048 pairs at least each).
-  ASSERT_GT(ComputeSuperpixelPairs(image, edge, grid, {}).pairs.size(), 20000u);
+  ASSERT_GT(ComputeSuperpixelPairs(image, edge, grid).pairs.size(), 20000u);
   const int threads_before = cv::getNumThreads();
   cv::setNumThreads(1);
   const cv::Mat1f one = Painted(*classifier_, image, edge, grid);
-  const SuperpixelPairs pairs_one = ComputeSuperpixelPairs(image, edge, grid, {});
+  const SuperpixelPairs pairs_one = ComputeSuperpixelPairs(image, edge, grid);
   cv::setNumThreads(3);
   const cv::Mat1f three = Painted(*classifier_, image, edge, grid);
-  const SuperpixelPairs pairs_three = ComputeSuperpixelPairs(image, edge, grid, {});
+  const SuperpixelPairs pairs_three = ComputeSuperpixelPairs(image, edge, grid);
   cv::setNumThreads(threads_before);
   // The pair features (region statistics beside the boundary scan, pairs in pieces) too.
   EXPECT_EQ(pairs_one.pairs, pairs_three.pairs);
@@ -522,7 +477,7 @@ TEST_F(TrainedOcclusionTest, ScreenedPaintIsTheMapOfTheScreenedPairValues) {
       classifier_->Paint(f.image, f.enhanced_edge, f.superpixels, options, &walked);
   ASSERT_TRUE(screened.ok());
   EXPECT_EQ(walked, classifier_->num_trees());
-  const SuperpixelPairs pairs = ComputeSuperpixelPairs(f.image, f.enhanced_edge, f.superpixels, {});
+  const SuperpixelPairs pairs = ComputeSuperpixelPairs(f.image, f.enhanced_edge, f.superpixels);
   ForestWalkOptions walk;
   walk.screening = screening;
   const std::vector<float> values =

@@ -45,16 +45,6 @@ NoiseScene MakeNoise(int width, int height, int seed) {
   return s;
 }
 
-// Smooth random colour blobs: a cell grid of random colours resized with cubic interpolation.
-cv::Mat3b BlobImage(cv::Size size, cv::Size cells, int seed) {
-  cv::Mat3b blobs(cells);
-  cv::RNG rng(seed);
-  rng.fill(blobs, cv::RNG::UNIFORM, 0, 256);
-  cv::Mat3b image;
-  cv::resize(blobs, image, size, 0, 0, cv::INTER_CUBIC);
-  return image;
-}
-
 // A dark disc on a flat light background; Ê = 1 on the disc's inner contour, 0 elsewhere.
 struct DiscScene {
   cv::Mat3b image;
@@ -210,39 +200,6 @@ TEST(RefineStickyLabelsTest, EdgeTermSnapsBorderToEdge) {
   EXPECT_EQ(labels, (std::vector<int>{0, 0, 0, 1}));
 }
 
-// Random colours and edges, and a size term strong enough that labels grow over many strips of
-// 4 rows: the strip order then has to hold back the pixels next to such labels. The labels must
-// not depend on how many threads run the strips.
-TEST(RefineStickyLabelsTest, StripsGiveTheSameLabelsOnAnyThreads) {
-  const int width = 64, height = 48;
-  const NoiseScene scene = MakeNoise(width, height, 5);
-  const StickyImage image = scene.view();
-  const StickyWeights w{.size = 50.0, .position = 1e-4, .edge = 0.1, .colour = 0.05};
-  const std::vector<int>& initial = scene.one_label_per_pixel;
-  const int threads_before = cv::getNumThreads();
-  std::vector<std::vector<int>> results;
-  for (const int threads : {1, 3}) {
-    cv::setNumThreads(threads);
-    std::vector<int> labels = initial;
-    RefineStickyLabels(image, w, 6, labels, /*strip_rows=*/4);
-    results.push_back(labels);
-  }
-  cv::setNumThreads(threads_before);
-  EXPECT_EQ(results[0], results[1]);
-  // Labels did reach over whole strips (the held-back path ran): some label spans > 6 rows.
-  std::vector<int> first_row(initial.size(), height), last_row(initial.size(), -1);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const int l = results[0][static_cast<size_t>(y) * width + x];
-      first_row[l] = std::min(first_row[l], y);
-      last_row[l] = std::max(last_row[l], y);
-    }
-  int tallest = 0;
-  for (size_t l = 0; l < initial.size(); ++l)
-    tallest = std::max(tallest, last_row[l] - first_row[l]);
-  EXPECT_GT(tallest, 6);
-}
-
 // The raster order on several threads runs as many sweeps at once, each a few rows behind the one
 // before it. The size term grows labels over many rows, so a sweep must often wait for the ones
 // ahead to leave a label alone: the labels must still be those of one thread, bit for bit.
@@ -289,45 +246,6 @@ TEST(StickySuperpixelsTest, TwoThreadsGiveTheSuperpixelsOfOne) {
   cv::setNumThreads(threads_before);
   EXPECT_EQ(one.count, two.count);
   EXPECT_EQ(cv::countNonZero(one.labels != two.labels), 0);
-}
-
-// The strip order against the raster order (strip_rows = 0, the reference and the default): the
-// same superpixels but for the order pixels are visited in. On real frames 98.7 % of the
-// boundary pixels are the same; on this textured scene at least 95 %, and 98 % within a pixel of
-// one.
-TEST(StickySuperpixelsTest, StripOrderStaysCloseToRasterOrder) {
-  const cv::Mat3b image = BlobImage({400, 300}, {40, 30}, 9);
-  cv::Mat1b grey;
-  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  cv::Mat1f gx, gy, edge;
-  cv::Sobel(grey, gx, CV_32F, 1, 0);
-  cv::Sobel(grey, gy, CV_32F, 0, 1);
-  cv::magnitude(gx, gy, edge);
-  edge /= 200.f;
-  StickySuperpixelParams raster;
-  raster.strip_rows = 0;
-  const Superpixels reference = Computed(image, edge, raster);
-  StickySuperpixelParams strips;
-  strips.strip_rows = 32;
-  const Superpixels fast = Computed(image, edge, strips);
-  ExpectConsecutiveLabels(fast);
-  ExpectSeparatedByBoundaries(fast.labels);
-  EXPECT_NEAR(fast.count, reference.count, 0.03 * reference.count);
-  const cv::Mat1b fast_boundary = fast.labels == 0, reference_boundary = reference.labels == 0;
-  cv::Mat1b near_reference;
-  cv::dilate(reference_boundary, near_reference, cv::Mat());
-  const double boundary = cv::countNonZero(fast_boundary);
-  EXPECT_GE(cv::countNonZero(fast_boundary & reference_boundary), 0.95 * boundary);
-  EXPECT_GE(cv::countNonZero(fast_boundary & near_reference), 0.98 * boundary);
-}
-
-TEST(StickySuperpixelsTest, NegativeStripRowsAreRejected) {
-  StickySuperpixelParams bad;
-  bad.strip_rows = -1;
-  const Result<Superpixels> checked =
-      ComputeStickySuperpixels(cv::Mat3b(10, 12, cv::Vec3b(1, 2, 3)), cv::Mat1f(10, 12, 0.f), bad);
-  ASSERT_FALSE(checked.ok());
-  EXPECT_NE(checked.status().message().find("strip_rows"), std::string::npos);
 }
 
 TEST(SuperpixelBoundariesTest, StrongerEdgePixelBecomesBoundary) {

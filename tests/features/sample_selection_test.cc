@@ -301,51 +301,5 @@ TEST(SampleSelectionTest, WithoutRoadLabelBothRegressorsDrawFromEveryNonObstacle
   EXPECT_NE(selected->ordr_indices, selected->obdr_indices);  // independent draws
 }
 
-// Balanced bagging: each bag is a draw of the paper's counts, disjoint from the other bags';
-// positives belong to every bag; one bag is the paper's draw, row for row.
-TEST(SampleSelectionTest, NegativeBagsAreDisjointDrawsOfTheSameCounts) {
-  const Sample gt = WithoutRoadLabel();
-  const std::vector<ScoredBox> proposals = GridOfBoxes(5, 2);
-  SampleSelectionParams params = SmallParams();
-  params.ordr_negatives = {6, 6};
-  params.obdr_negatives = {4, 4};
-  auto one = SelectTrainingSamples(proposals, gt, kLimits, params, 9);
-  params.negative_bags = 3;
-  auto three = SelectTrainingSamples(proposals, gt, kLimits, params, 9);
-  ASSERT_TRUE(one.ok() && three.ok()) << three.status().message();
-
-  const std::size_t positives = three->positive_indices.size();
-  ASSERT_GT(positives, 0u);
-  ASSERT_EQ(three->ordr_bags.size(), three->ordr_indices.size());
-  ASSERT_EQ(three->obdr_bags.size(), three->obdr_indices.size());
-  for (std::size_t j = 0; j < positives; ++j) {
-    EXPECT_EQ(three->ordr_bags[j], SelectedSamples::kEveryBag);
-    EXPECT_EQ(three->obdr_bags[j], SelectedSamples::kEveryBag);
-  }
-  const auto per_bag = [&](const std::vector<int>& bags) {
-    std::vector<int> counts(3, 0);
-    for (std::size_t j = positives; j < bags.size(); ++j) ++counts.at(bags[j]);
-    return counts;
-  };
-  EXPECT_EQ(per_bag(three->ordr_bags), (std::vector<int>{12, 12, 12}));
-  EXPECT_EQ(per_bag(three->obdr_bags), (std::vector<int>{8, 8, 8}));
-  // Disjoint within each regressor.
-  EXPECT_EQ(std::set<int>(three->ordr_indices.begin(), three->ordr_indices.end()).size(),
-            three->ordr_indices.size());
-  EXPECT_EQ(std::set<int>(three->obdr_indices.begin(), three->obdr_indices.end()).size(),
-            three->obdr_indices.size());
-  // The first bag is the single draw.
-  ASSERT_EQ(one->ordr_indices.size(), positives + 12);
-  EXPECT_TRUE(
-      std::equal(one->ordr_indices.begin(), one->ordr_indices.end(), three->ordr_indices.begin()));
-  EXPECT_EQ(one->ordr_bags,
-            std::vector<int>(three->ordr_bags.begin(), three->ordr_bags.begin() + positives + 12));
-
-  params.negative_bags = 0;
-  auto none = SelectTrainingSamples(proposals, gt, kLimits, params, 9);
-  ASSERT_FALSE(none.ok());
-  EXPECT_NE(none.status().message().find("negative_bags"), std::string::npos);
-}
-
 }  // namespace
 }  // namespace tod

@@ -63,31 +63,6 @@ double BruteForceShare(const cv::Mat3b& bgr, const cv::Rect& rect,
   return counted > 0 ? vertical / counted : 0.0;
 }
 
-// Feature 22 by its definition: each counted pixel's gradient direction in degrees modulo 180,
-// in one of 8 bins centred on multiples of 22.5, and the entropy of the bins' shares over ln 8.
-double BruteForceEntropy(const cv::Mat3b& bgr, const cv::Rect& rect) {
-  std::array<double, 8> bins{};
-  double counted = 0;
-  ForEachGradient(bgr, rect, [&](float gx, float gy, double m) {
-    if (m < VerticalEdgeParams{}.min_gradient) return;
-    double degrees = std::atan2(static_cast<double>(gy), static_cast<double>(gx)) * 180.0 / CV_PI;
-    if (degrees < 0) degrees += 180.0;
-    bins[static_cast<int>(std::floor(degrees / 22.5 + 0.5)) % 8] += 1;
-    counted += 1;
-  });
-  double entropy = 0;
-  for (const double n : bins)
-    if (n > 0) entropy -= n / counted * std::log(n / counted);
-  return counted > 0 ? entropy / std::log(8.0) : 0.0;
-}
-
-// A dark disc on grey: its outline has every orientation.
-cv::Mat3b Disc(int size) {
-  cv::Mat1b grey(size, size, uchar{200});
-  cv::circle(grey, {size / 2, size / 2}, size / 3, cv::Scalar(30), cv::FILLED);
-  return AsBgr(grey);
-}
-
 TEST(VerticalEdgeIntegrals, UprightBarsAreVerticalLyingAndSlantedBarsAreNot) {
   const cv::Rect all(0, 0, 64, 64);
   EXPECT_NEAR(VerticalEdgeIntegrals(Bar(64, 0, 9), {0, 0}).Share(all), 1.0, 1e-9);
@@ -131,101 +106,14 @@ TEST(VerticalEdgeIntegrals, SameTablesOnAnyThreadCount) {
   const cv::Mat3b bgr = AsBgr(grey);
   const int before = cv::getNumThreads();
   cv::setNumThreads(1);
-  const VerticalEdgeParams with_orientations{.orientation_tables = true};
-  const VerticalEdgeIntegrals one(bgr, {0, 0}, with_orientations);
+  const VerticalEdgeIntegrals one(bgr, {0, 0});
   cv::setNumThreads(4);
-  const VerticalEdgeIntegrals four(bgr, {0, 0}, with_orientations);
+  const VerticalEdgeIntegrals four(bgr, {0, 0});
   cv::setNumThreads(before);
   for (const cv::Rect r :
        {cv::Rect(0, 0, 200, 300), cv::Rect(13, 70, 50, 31), cv::Rect(199, 0, 1, 300)}) {
     EXPECT_EQ(one.Share(r), four.Share(r)) << r;
-    EXPECT_EQ(one.OrientationEntropy(r), four.OrientationEntropy(r)) << r;
   }
-}
-
-TEST(OrientationEntropy, OneWayEdgesAreLowAnOutlineOfEveryWayIsHigh) {
-  const VerticalEdgeParams with_orientations{.orientation_tables = true};
-  const cv::Rect all(0, 0, 64, 64);
-  // A bar's two sides run one way: every counted gradient in one bin (vertical, lying, or one of
-  // the diagonal bins), up to the odd pixel where a slanted line steps.
-  EXPECT_NEAR(
-      VerticalEdgeIntegrals(Bar(64, 0, 9), {0, 0}, with_orientations).OrientationEntropy(all), 0.0,
-      1e-9);
-  EXPECT_NEAR(
-      VerticalEdgeIntegrals(Bar(64, 90, 9), {0, 0}, with_orientations).OrientationEntropy(all), 0.0,
-      1e-9);
-  EXPECT_LT(
-      VerticalEdgeIntegrals(Bar(64, 45, 9), {0, 0}, with_orientations).OrientationEntropy(all),
-      0.35);
-  const double disc =
-      VerticalEdgeIntegrals(Disc(64), {0, 0}, with_orientations).OrientationEntropy(all);
-  EXPECT_GT(disc, 0.95);
-  EXPECT_LE(disc, 1.0);
-  // Flat: nothing counts. Without orientation tables the entropy is 0 too (and the extractor
-  // refuses to read it, below).
-  EXPECT_EQ(VerticalEdgeIntegrals(AsBgr(cv::Mat1b(32, 32, uchar{90})), {0, 0}, with_orientations)
-                .OrientationEntropy({0, 0, 32, 32}),
-            0.0);
-  const VerticalEdgeIntegrals plain(Disc(64), {0, 0});
-  EXPECT_FALSE(plain.has_orientation_tables());
-  EXPECT_EQ(plain.OrientationEntropy(all), 0.0);
-}
-
-TEST(OrientationEntropy, EveryRectangleMatchesThePixelDefinition) {
-  std::mt19937 rng(7);
-  cv::Mat1b grey(90, 120);
-  cv::randu(grey, 0, 256);
-  cv::GaussianBlur(grey, grey, cv::Size(5, 5), 1.2);
-  for (int i = 0; i < 12; ++i)
-    cv::line(grey, {static_cast<int>(rng() % 120), static_cast<int>(rng() % 90)},
-             {static_cast<int>(rng() % 120), static_cast<int>(rng() % 90)},
-             cv::Scalar(static_cast<int>(rng() % 256)), 3);
-  const cv::Mat3b bgr = AsBgr(grey);
-  const VerticalEdgeIntegrals table(bgr, {300, 200}, {.orientation_tables = true});
-  ASSERT_TRUE(table.has_orientation_tables());
-  for (int i = 0; i < 200; ++i) {
-    const int x = rng() % 120, y = rng() % 90;
-    const cv::Rect r(x, y, 1 + rng() % (120 - x), 1 + rng() % (90 - y));
-    EXPECT_NEAR(table.OrientationEntropy(r), BruteForceEntropy(bgr, r), 1e-12) << r;
-  }
-}
-
-// Feature 22 in the extractor: the entropy of the clipped box in the 22nd column, after feature
-// 21, or in the 21st without it; shared tables built without orientations are refused.
-TEST(OrientationEntropyFeature, TwentySecondColumnIsTheBoxsOrientationEntropy) {
-  const cv::Mat3b bgr = Disc(64);
-  const cv::Mat1f map(64, 64, 0.f);
-  BoxFeatureOptions options;
-  options.vertical_edges = true;
-  options.orientation_entropy = true;
-  EXPECT_EQ(NumBoxFeatures(options), 22);
-  const BoxFeatureExtractor own(map, bgr, {0, 0}, {64, 64}, options);
-  ASSERT_TRUE(own.status().ok()) << own.status().message();
-  const std::vector<ScoredBox> boxes = {{{0, 0, 64, 64}, 0.5f}, {{28, 28, 8, 8}, 0.1f}};
-  const cv::Mat1f rows = own.ComputeAll(boxes);
-  ASSERT_EQ(rows.cols, 22);
-  EXPECT_FLOAT_EQ(rows(0, 21), static_cast<float>(BruteForceEntropy(bgr, {0, 0, 64, 64})));
-  EXPECT_FLOAT_EQ(rows(0, 20), static_cast<float>(BruteForceShare(bgr, {0, 0, 64, 64})));
-  EXPECT_FLOAT_EQ(rows(1, 21), 0.f);  // inside the disc: flat
-
-  BoxFeatureOptions alone;
-  alone.orientation_entropy = true;
-  EXPECT_EQ(NumBoxFeatures(alone), 21);
-  const cv::Mat1f alone_rows =
-      BoxFeatureExtractor(map, bgr, {0, 0}, {64, 64}, alone).ComputeAll(boxes);
-  ASSERT_EQ(alone_rows.cols, 21);
-  EXPECT_EQ(alone_rows(0, 20), rows(0, 21));
-
-  const auto colour = std::make_shared<const ColourIntegrals>(bgr, cv::Point(0, 0));
-  const auto without = std::make_shared<const VerticalEdgeIntegrals>(bgr, cv::Point(0, 0));
-  const BoxFeatureExtractor no_tables(colour, map, {0, 0}, {64, 64}, options, without);
-  EXPECT_FALSE(no_tables.status().ok());
-  EXPECT_NE(no_tables.status().message().find("orientation tables"), std::string::npos);
-  const auto with = std::make_shared<const VerticalEdgeIntegrals>(
-      bgr, cv::Point(0, 0), VerticalEdgeParams{.orientation_tables = true});
-  const BoxFeatureExtractor shared(colour, map, {0, 0}, {64, 64}, options, with);
-  ASSERT_TRUE(shared.status().ok()) << shared.status().message();
-  EXPECT_FLOAT_EQ(shared.Compute({0, 0, 64, 64}, 0.f)[21], rows(0, 21));
 }
 
 // Feature 21 in the extractor: the table's share of the clipped box, 21 columns with the option,

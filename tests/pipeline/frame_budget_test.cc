@@ -137,8 +137,7 @@ TEST_F(DetectBudgetTest, RegressionPastItsDeadlineDropsTheUnscoredProposals) {
   const FrameGeometry geometry = GeometryForFrame(detector_->bundle(), frame_.cols, frame_.rows);
   const ModelBundle& bundle = detector_->bundle();
   const Result<OcclusionEdges> computed = ComputeOcclusionEdges(
-      frame_, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, frame_.cols, frame_.rows), bundle.params, true);
+      frame_, geometry.regions, *bundle.edges, &bundle.occlusion, bundle.params, true);
   ASSERT_TRUE(computed.ok()) << computed.status().ToString();
   const OcclusionEdges& oaocc = *computed;
   const ProposalSet proposals = ProposeBoxes(

@@ -62,18 +62,6 @@ TEST(FrameGeometryTest, FeatureHorizonMapsLikeTheRows) {
                    397.0 * 0.625 + (360 - 0.625 * 512));
 }
 
-// The occlusion features' horizon is its own choice, mapped the same way.
-TEST(FrameGeometryTest, OcclusionHorizonMapsLikeTheRows) {
-  ModelBundle bundle = BundleAt2048x1024();
-  bundle.params.box_features = {.ground_plane_size = true, .horizon_y = 397.0};
-  EXPECT_FALSE(OcclusionFeatureOptionsForFrame(bundle, 2048, 1024).horizon_y.has_value());
-  bundle.params.occlusion_features = {.ground_plane_size = true, .horizon_y = 401.0};
-  EXPECT_DOUBLE_EQ(*OcclusionFeatureOptionsForFrame(bundle, 2048, 1024).horizon_y, 401.0);
-  EXPECT_DOUBLE_EQ(*OcclusionFeatureOptionsForFrame(bundle, 1920, 1080).horizon_y,
-                   401.0 * 0.9375 + 60);
-  EXPECT_EQ(OcclusionFeatureOptionsForFrame(bundle, 1920, 1080).crop_y, 0);
-}
-
 TEST(FrameGeometryTest, SmallerFrameScalesEverythingByOneFactor) {
   const FrameGeometry g = GeometryForFrame(BundleAt2048x1024(), 1280, 720);
   const double s = 0.625, dy = 360 - 0.625 * 512;

@@ -27,62 +27,13 @@ TEST(FrameStagesTest, ComputesEveryMapOnR1) {
   EXPECT_GT(cv::countNonZero(oaocc->occlusion), 0);
 }
 
-// Ground-plane occlusion features: the classifier paints with the horizon and the crop's first
-// frame row (R1's), not with pixel sizes.
-TEST(FrameStagesTest, OcclusionMapUsesTheFeatureHorizonAndTheCropRow) {
-  ModelBundle bundle = TinyBundle();
-  const cv::Mat3b frame = RoadFrame(512, 256);
-  const FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
-  const OcclusionFeatureOptions ground{.horizon_y = 100.0};
-  // A small classifier that reads the sizes: trained on this frame's pairs, with a block of
-  // "obstacle" in the lower middle of R1 so that there are contour pairs.
-  {
-    const Result<OcclusionEdges> untrained = ComputeOcclusionEdges(
-        frame, geometry.regions, *bundle.edges, nullptr, {}, bundle.params, true);
-    ASSERT_TRUE(untrained.ok()) << untrained.status().ToString();
-    const cv::Size crop = untrained->crop.size();
-    cv::Mat1i labels(crop, 1);
-    labels(cv::Rect(crop.width / 3, crop.height / 2, crop.width / 3, crop.height / 3)).setTo(2);
-    OcclusionParams params;
-    params.forest.num_trees = 8;
-    auto fitted = OcclusionClassifier::Fit({{untrained->crop,
-                                             untrained->enhanced,
-                                             untrained->superpixels,
-                                             labels,
-                                             {.horizon_y = 100.0, .crop_y = untrained->r1.y}}},
-                                           params);
-    ASSERT_TRUE(fitted.ok()) << fitted.status().ToString();
-    bundle.occlusion = std::move(fitted).value();
-  }
-  const Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
-      frame, geometry.regions, *bundle.edges, &bundle.occlusion, ground, bundle.params, true);
-  ASSERT_TRUE(oaocc.ok()) << oaocc.status().ToString();
-  ASSERT_GT(oaocc->r1.y, 0);
-  const auto paint = [&](const OcclusionFeatureOptions& features) {
-    OcclusionPaintOptions options;
-    options.features = features;
-    Result<cv::Mat1f> painted =
-        bundle.occlusion.Paint(oaocc->crop, oaocc->enhanced, oaocc->superpixels, options);
-    EXPECT_TRUE(painted.ok()) << painted.status().ToString();
-    cv::Mat1f map = std::move(painted).value();
-    CorrectSampledPrior(map, bundle.params.prior_correction.occlusion_odds);
-    return map;
-  };
-  const cv::Mat1f expected = paint({.horizon_y = 100.0, .crop_y = oaocc->r1.y});
-  EXPECT_EQ(cv::norm(oaocc->occlusion, expected, cv::NORM_INF), 0.0);
-  // The horizon matters: pixel sizes or the crop's own rows paint another map.
-  EXPECT_GT(cv::norm(oaocc->occlusion, paint({}), cv::NORM_INF), 0.0);
-  EXPECT_GT(cv::norm(oaocc->occlusion, paint({.horizon_y = 100.0}), cv::NORM_INF), 0.0);
-}
-
 TEST(FrameStagesTest, SuperpixelStageRejectingItsParametersIsAnError) {
   ModelBundle bundle = TinyBundle();
   bundle.params.superpixels.k = 0;  // a loaded bundle cannot hold this (its params are checked)
   const cv::Mat3b frame = RoadFrame(512, 256);
   const FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
   const Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
-      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
+      frame, geometry.regions, *bundle.edges, &bundle.occlusion, bundle.params, true);
   ASSERT_FALSE(oaocc.ok());
   EXPECT_EQ(oaocc.status().code(), StatusCode::kInvalidArgument);
   EXPECT_NE(oaocc.status().message().find("sticky superpixels"), std::string::npos)

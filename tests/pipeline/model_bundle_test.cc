@@ -4,10 +4,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <random>
 
 #include "core/base/binary_io.h"
+#include "core/pipeline/removed_options.h"
 #include "tests/forest/fitted_forest.h"
 #include "tests/test_env.h"
 
@@ -28,7 +30,7 @@ class ModelBundleTest : public ::testing::Test {
 
   static ModelBundle SmallBundle(std::uint64_t seed) {
     ModelBundle b;
-    b.edge_kind = "gradient";
+    b.edge_kind = EdgeKind::kGradient;
     b.edges = CreateGradientEdgeSource();
     b.regions = Laf2020Regions();
     b.size_filter = SizeFilter::Laf2020();
@@ -66,7 +68,7 @@ TEST(ShippedModelBundle, LoadsAndEveryLearnedFileReencodesByteForByte) {
   const fs::path dir = fs::path(testing_env::SourceDir()) / "models" / "default";
   const Result<ModelBundle> bundle = LoadModelBundle(dir.string());
   ASSERT_TRUE(bundle.ok()) << bundle.status().message();
-  ASSERT_EQ(bundle->edge_kind, "pixel_forest");
+  ASSERT_EQ(bundle->edge_kind, EdgeKind::kPixelForest);
   const auto* edges = dynamic_cast<const PixelEdgeClassifier*>(bundle->edges.get());
   ASSERT_NE(edges, nullptr);
   EXPECT_EQ(EncodeModel(*edges).value(), FileBytes(dir / "edges.bin"));
@@ -90,7 +92,7 @@ TEST_F(ModelBundleTest, SaveLoadRoundTripKeepsEveryPart) {
   auto loaded = LoadModelBundle(Path());
   ASSERT_TRUE(loaded.ok()) << loaded.status().ToString();
   EXPECT_EQ(loaded->regions.layers, b.regions.layers);
-  EXPECT_EQ(loaded->edge_kind, "gradient");
+  EXPECT_EQ(loaded->edge_kind, EdgeKind::kGradient);
   EXPECT_EQ(loaded->version, "test");
   EXPECT_FALSE(loaded->created.empty());
   const float row[20] = {0.9f};
@@ -160,7 +162,7 @@ TEST_F(ModelBundleTest, UnknownEdgeSourceAndMissingSedModelAreRefused) {
   ASSERT_TRUE(SaveModelBundle(SmallBundle(1), Path()).ok());
   auto loaded = LoadModelBundle(Path());
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
-  EXPECT_EQ(loaded->edges->kind(), "gradient");
+  EXPECT_EQ(loaded->edges->kind(), EdgeKind::kGradient);
   const fs::path manifest = fs::path(Path()) / "manifest.json";
   std::ifstream in(manifest);
   nlohmann::json j = nlohmann::json::parse(in);
@@ -190,6 +192,68 @@ TEST_F(ModelBundleTest, EvalNumbersAreAddedToTheManifest) {
   auto loaded = LoadModelBundle(Path());
   ASSERT_TRUE(loaded.ok());
   EXPECT_EQ(loaded->eval["frames"], 3);
+}
+
+// A bundle whose manifest records an option measured and removed (docs/findings.md, "Real frames,
+// not adopted") is refused, naming the option and how to retrain; one written now records every
+// removed key at its one value and loads, and so does one that predates the keys.
+TEST_F(ModelBundleTest, RemovedOptionsAreRefusedByNameOthersLoad) {
+  ModelBundle bundle = SmallBundle(3);
+  bundle.training["seed"] = 3;
+  ASSERT_TRUE(SaveModelBundle(bundle, Path()).ok());
+  const fs::path manifest_path = fs::path(Path()) / "manifest.json";
+  const nlohmann::json written = nlohmann::json::parse(FileBytes(manifest_path));
+  EXPECT_EQ(written["params"]["orientation_entropy_feature"], false);
+  EXPECT_EQ(written["params"]["superpixels"]["strip_rows"], 0);
+  EXPECT_EQ(written["params"]["edge_screening"]["trees"], 0);
+  EXPECT_EQ(written["params"]["occlusion_features"]["ground_plane_size"], false);
+  ASSERT_TRUE(LoadModelBundle(Path()).ok());
+
+  const auto load_with = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = written;
+    edit(j);
+    std::ofstream(manifest_path) << j.dump(2);
+    return LoadModelBundle(Path());
+  };
+  const auto entropy =
+      load_with([](nlohmann::json& j) { j["params"]["orientation_entropy_feature"] = true; });
+  ASSERT_FALSE(entropy.ok());
+  EXPECT_EQ(entropy.status().code(), StatusCode::kFailedPrecondition);
+  const std::string message = entropy.status().message();
+  EXPECT_NE(message.find("--orientation-entropy-feature"), std::string::npos) << message;
+  EXPECT_NE(message.find("docs/findings.md#orientation-entropy-feature"), std::string::npos);
+  EXPECT_NE(message.find("retrain with tod train --data unit test --seed 3 --out DIR"),
+            std::string::npos)
+      << message;
+  const auto strips =
+      load_with([](nlohmann::json& j) { j["params"]["superpixels"]["strip_rows"] = 32; });
+  ASSERT_FALSE(strips.ok());
+  EXPECT_NE(strips.status().message().find("--superpixel-strips"), std::string::npos);
+  const auto folds = load_with([](nlohmann::json& j) {
+    j["training"]["parts"]["ordr"] = {{"fold_layout", "alternate"}, {"negative_bags", 1}};
+  });
+  ASSERT_FALSE(folds.ok());
+  EXPECT_NE(folds.status().message().find("--fold-layout alternate"), std::string::npos);
+  // Written before the keys existed: nothing to refuse.
+  EXPECT_TRUE(load_with([](nlohmann::json& j) {
+                j["params"].erase("orientation_entropy_feature");
+                j["params"].erase("edge_screening");
+                j["params"].erase("occlusion_features");
+                j["params"]["superpixels"].erase("strip_rows");
+              }).ok());
+}
+
+// models/default was written before the removal and records every removed key it knows at the
+// value that remains: it loads (ShippedModelBundle above), and nothing in it is refused.
+TEST(ShippedModelBundle, RecordsEveryRemovedOptionAtItsRemainingValue) {
+  const fs::path manifest = fs::path(testing_env::SourceDir()) / "models/default/manifest.json";
+  const nlohmann::json j = nlohmann::json::parse(FileBytes(manifest));
+  EXPECT_TRUE(RefuseRemovedOptions(j, manifest.string()).ok());
+  for (const RemovedOption& option : RemovedOptions()) {
+    const nlohmann::json::json_pointer key(option.key);
+    ASSERT_TRUE(j.contains(key)) << option.key;
+    EXPECT_EQ(j.at(key), option.value) << option.key;
+  }
 }
 
 }  // namespace

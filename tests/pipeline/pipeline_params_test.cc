@@ -44,20 +44,16 @@ TEST(PipelineParams, ProposalFeaturesFollowTheOptionalFeatures) {
   EXPECT_EQ(ProposalFeatureSet(p), "the paper's 20");
   p.vertical_edge_feature = true;
   EXPECT_EQ(ProposalFeatureCount(p), 21);
-  p.orientation_entropy_feature = true;
-  EXPECT_EQ(ProposalFeatureCount(p), 22);
-  EXPECT_EQ(ProposalFeatureSet(p),
-            "the paper's 20, the vertical edge share, the orientation entropy");
-  p.vertical_edge_feature = false;
-  EXPECT_EQ(ProposalFeatureCount(p), 21);
-  EXPECT_EQ(ProposalFeatureSet(p), "the paper's 20, the orientation entropy");
+  EXPECT_EQ(ProposalFeatureSet(p), "the paper's 20, the vertical edge share");
   p.road_surround_feature = true;
   EXPECT_EQ(ProposalFeatureCount(p), 22);
   EXPECT_EQ(ProposalFeatureSet(p),
-            "the paper's 20, the orientation entropy, the surround unlike the road");
+            "the paper's 20, the vertical edge share, the surround unlike the road");
+  p.vertical_edge_feature = false;
+  EXPECT_EQ(ProposalFeatureCount(p), 21);
+  EXPECT_EQ(ProposalFeatureSet(p), "the paper's 20, the surround unlike the road");
   const auto older = PipelineParamsFromJson({{"vertical_edge_feature", true}});
   ASSERT_TRUE(older.ok());
-  EXPECT_FALSE(older->orientation_entropy_feature);
   EXPECT_FALSE(older->road_surround_feature);
   EXPECT_EQ(ProposalFeatureCount(*older), 21);
 }

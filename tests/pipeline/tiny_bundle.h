@@ -20,7 +20,7 @@ namespace tod {
 // regions and size filter) with tiny forests: enough to run every stage on a small frame.
 inline ModelBundle TinyBundle() {
   ModelBundle b;
-  b.edge_kind = "gradient";
+  b.edge_kind = EdgeKind::kGradient;
   b.edges = CreateGradientEdgeSource();
   b.regions = Laf2020Regions();
   b.size_filter = SizeFilter::Laf2020();
@@ -68,9 +68,8 @@ struct RoadFrameMaps {
   ModelBundle bundle = TinyBundle();
   cv::Mat3b frame = RoadFrame(512, 256);
   FrameGeometry geometry = GeometryForFrame(bundle, frame.cols, frame.rows);
-  Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(
-      frame, geometry.regions, *bundle.edges, &bundle.occlusion,
-      OcclusionFeatureOptionsForFrame(bundle, frame.cols, frame.rows), bundle.params, true);
+  Result<OcclusionEdges> oaocc = ComputeOcclusionEdges(frame, geometry.regions, *bundle.edges,
+                                                       &bundle.occlusion, bundle.params, true);
 };
 
 // A suite whose tests share one ObstacleDetector on TinyBundle() (training its forests once).
