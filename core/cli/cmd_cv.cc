@@ -55,7 +55,6 @@ Runner AddCvCommand(CLI::App& app) {
   return [args] {
     BoundOpenCvThreads(args->recipe.threads);
     TrainOptions recipe = args->recipe;
-    recipe.data.format = "masks";
     recipe.regressor_trees = args->trees;
     for (const std::string& name : args->paper)
       ApplyPaperSwitch(*ParseEnum<PaperSwitch>(name), recipe);  // checked by CLI11

@@ -41,18 +41,24 @@ std::string FoldSplitFile(const std::vector<CvFold>& folds, std::size_t k) {
 
 // The stems of every frame of the recipe's dataset (its split file's listed ones, if any).
 Result<std::vector<std::string>> AllStems(const TrainOptions& recipe) {
+  std::string format = recipe.data.format;
+  if (format == "auto") {
+    auto detected = DetectDatasetFormat(recipe.data.data_root);
+    if (!detected.ok()) return detected.status();
+    format = *detected;
+  }
+  if (format != "masks")
+    return Status::InvalidArgument(
+        "cross-validation needs a dataset in the masks layout (images/ + labels_masks/), whose "
+        "folds it writes as split files; " +
+        recipe.data.data_root + " is " + format);
   DatasetSpec spec;
   spec.root = recipe.data.data_root;
-  spec.format = recipe.data.format;
+  spec.format = format;
   spec.split = "all";
   spec.split_file = recipe.data.split_file;
   auto selection = SelectFrames(spec);
   if (!selection.ok()) return selection.status();
-  if (selection->format != "masks")
-    return Status::InvalidArgument(
-        "cross-validation needs a dataset in the masks layout (images/ + labels_masks/), whose "
-        "folds it writes as split files; " +
-        recipe.data.data_root + " is " + selection->format);
   std::vector<std::string> stems;
   for (int i : selection->frames) stems.push_back(selection->dataset->name(i));
   return stems;

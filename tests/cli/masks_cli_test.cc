@@ -599,6 +599,45 @@ void ExpectMoreRegressorSamples(const nlohmann::json& with, const nlohmann::json
   EXPECT_EQ(with["mean_proposals_per_frame"], without["mean_proposals_per_frame"]);
 }
 
+// `tod cv`: two folds of consecutive frames, each trained on the other and evaluated on itself;
+// per fold and the mean with its spread, under "cv"; a LAF-layout set is refused (its folds
+// cannot be written as split files).
+TEST_F(MasksCliTest, CrossValidationOverFoldsOfConsecutiveFrames) {
+  const std::string json = (out_ / "cv.json").string();
+  const CommandResult cv = RunCommand(tod_ + " cv --data " + Root() + " --work " +
+                                      (out_ / "cv").string() + " --folds 2 --seeds 1 --trees 4 " +
+                                      "--classifier-frames 4 --threads 2 --json " + json);
+  ASSERT_EQ(cv.exit_code, 0) << cv.output;
+  EXPECT_NE(cv.output.find("2-fold cross-validation, 1 seed from 1"), std::string::npos)
+      << cv.output;
+  EXPECT_NE(cv.output.find("BP+Fusion pixel AP"), std::string::npos) << cv.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in)["cv"];
+  EXPECT_EQ(j["folds"], 2);
+  ASSERT_EQ(j["per_fold"].size(), 2u);
+  ASSERT_EQ(j["runs"].size(), 2u);
+  // The folds are runs of the listed frames that together hold every one of them once.
+  const nlohmann::json& frames = j["fold_frames"];
+  int listed = 0;
+  std::ifstream split(fs::path(Root()) / "split.txt");
+  for (std::string line; std::getline(split, line);) listed += !line.empty() && line[0] != '#';
+  EXPECT_EQ(frames[0][2].get<int>() + frames[1][2].get<int>(), listed);
+  const std::string ap = "regression/BP+Fusion@4/ap";
+  for (int k = 0; k < 2; ++k)
+    EXPECT_EQ(j["runs"][k][0]["frames"].get<int>(), frames[k][2].get<int>()) << k;
+  ASSERT_TRUE(j["mean"].contains(ap)) << j["mean"].dump();
+  EXPECT_LE(j["min"][ap].get<double>(), j["mean"][ap].get<double>());
+  EXPECT_GE(j["max"][ap].get<double>(), j["mean"][ap].get<double>());
+  EXPECT_TRUE(fs::exists(out_ / "cv" / "fold1-split.txt"));
+  EXPECT_FALSE(fs::exists(out_ / "cv" / "fold1-seed1"));  // bundles only with --keep-models
+
+  const CommandResult laf =
+      RunCommand(tod_ + " cv --data " + tod::testing_env::TestData() + " --work " +
+                 (out_ / "cv_laf").string() + " --folds 2 --trees 4");
+  EXPECT_NE(laf.exit_code, 0) << laf.output;
+  EXPECT_NE(laf.output.find("masks layout"), std::string::npos) << laf.output;
+}
+
 }  // namespace
 
 // Truth boxes as positives (the default): every training obstacle's own box is one more positive
