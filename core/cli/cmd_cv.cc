@@ -7,7 +7,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
-#include "core/training/paper_switches.h"
+#include "core/cli/paper_option.h"
 #include "core/validation/cross_validation.h"
 
 namespace tod::cli {
@@ -43,12 +43,7 @@ Runner AddCvCommand(CLI::App& app) {
   cmd->add_option("--classifier-frames", args->recipe.classifier_frames,
                   "frames the edge and occlusion classifiers learn from (fewer: faster)")
       ->capture_default_str();
-  cmd->add_option("--paper", args->paper,
-                  "train this part as the paper does, as tod train --paper (repeatable):" +
-                      PaperSwitchesHelp())
-      ->check(CLI::IsMember(EnumNameList<PaperSwitch>()))
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  AddPaperOption(cmd, args->paper);
   cmd->add_option("--threads", args->recipe.threads, "worker threads (0 = all cores)");
   cmd->add_flag("--keep-models", args->cv.keep_models, "keep every fold's bundle under --work");
   cmd->add_option("--json", args->json, "write every number under \"cv\" to this file");
@@ -56,8 +51,7 @@ Runner AddCvCommand(CLI::App& app) {
     BoundOpenCvThreads(args->recipe.threads);
     TrainOptions recipe = args->recipe;
     recipe.regressor_trees = args->trees;
-    for (const std::string& name : args->paper)
-      ApplyPaperSwitch(*ParseEnum<PaperSwitch>(name), recipe);  // checked by CLI11
+    ApplyPaperSwitches(args->paper, recipe);
     recipe.progress = [](const std::string& line) { std::cerr << "train: " << line << "\n"; };
     EvalOptions eval = args->eval;
     eval.threads = recipe.threads;

@@ -11,9 +11,9 @@
 #include "core/base/enum_names.h"
 #include "core/cli/commands.h"
 #include "core/cli/dataset_options.h"
+#include "core/cli/paper_option.h"
 #include "core/evaluation/evaluator.h"
 #include "core/pipeline/model_bundle.h"
-#include "core/training/paper_switches.h"
 #include "core/training/trainer.h"
 
 namespace tod::cli {
@@ -85,16 +85,6 @@ void AddModelOptions(CLI::App* cmd, TrainArgs& args) {
                 "switch the box size filter (§4.3) off, for its ablation");
 }
 
-// One switch per adopted deviation, back to the paper's behaviour (the ablation table).
-void AddPaperOption(CLI::App* cmd, TrainArgs& args) {
-  cmd->add_option(
-         "--paper", args.paper,
-         "train this part as the paper does (repeatable; default: none):" + PaperSwitchesHelp())
-      ->check(CLI::IsMember(EnumNameList<PaperSwitch>()))
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-}
-
 // The evaluation that follows training.
 void AddEvalOptions(CLI::App* cmd, TrainArgs& args) {
   cmd->add_flag("--no-eval", args.no_eval, "do not evaluate the new bundle after training");
@@ -113,8 +103,7 @@ TrainOptions TrainOptionsFrom(const TrainArgs& args) {
   options.regions = *ParseEnum<RegionsSource>(args.regions);  // checked by CLI11
   options.edge_source = *ParseEnum<EdgeKind>(args.edge_source);
   if (!options.sed_model.empty()) options.edge_source = EdgeKind::kSed;
-  for (const std::string& name : args.paper)
-    ApplyPaperSwitch(*ParseEnum<PaperSwitch>(name), options);
+  ApplyPaperSwitches(args.paper, options);
   options.params.size_filter = !args.no_size_filter;
   options.progress = [](const std::string& line) { std::cerr << "train: " << line << "\n"; };
   return options;
@@ -149,7 +138,7 @@ Runner AddTrainCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("train", "train a model bundle from a dataset's train split");
   AddDataOptions(cmd, *args);
   AddModelOptions(cmd, *args);
-  AddPaperOption(cmd, *args);
+  AddPaperOption(cmd, args->paper);
   AddEvalOptions(cmd, *args);
   return [args] {
     BoundOpenCvThreads(args->train.threads);
