@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/datasets/dataset_factory.h"
+#include "core/evaluation/component_evaluation.h"
 #include "core/evaluation/frame_evaluation.h"
 #include "core/metrics/instance_recall.h"
 #include "core/pipeline/obstacle_detector.h"
@@ -16,6 +17,8 @@ namespace tod {
 namespace {
 
 const std::vector<int> kTableN = {200, 400, 600, 800, 1000};
+// The map `tod detect` serves at its defaults (MapKind::kNormalized).
+constexpr const char* kServedMapVariant = "BP+Fusion@4";
 
 VariantCurves Curves(const RecallAccumulator& acc) {
   VariantCurves c;
@@ -69,6 +72,8 @@ class EvalTotals {
       roc_.emplace(v, PixelRocAccumulator());
       histograms_.emplace(v, PixelHistogramAccumulator());
     }
+    component_maps_.emplace(kServedMapVariant, ComponentMapStore());
+    if (calibrated_map) component_maps_.emplace(kCalibratedMapVariant, ComponentMapStore());
   }
 
   Status Add(const FrameEvaluation& frame, const Sample& s) {
@@ -79,9 +84,15 @@ class EvalTotals {
       Status st = roc_.at(variant).Add(map, s.obstacle, s.road);
       if (st.ok()) st = histograms_.at(variant).Add(map, s.obstacle, s.road);
       if (!st.ok()) return st.WithContext(variant);
+      const auto kept = component_maps_.find(variant);
+      if (kept == component_maps_.end()) continue;
+      if (Status st = kept->second.Add(map, s); !st.ok()) return st.WithContext(variant);
     }
     reported_.false_alarms += frame.false_alarms;
     reported_.instances_found += frame.instances_found;
+    reported_.found_iou25 += frame.found_iou25;
+    reported_.found_iou50 += frame.found_iou50;
+    reported_components_.Add(frame.reported_components);
     if (s.instances.empty()) {
       ++reported_.obstacle_free_frames;
       reported_.false_alarms_on_obstacle_free += frame.false_alarms;
@@ -98,9 +109,19 @@ class EvalTotals {
     return Status::Ok();
   }
 
-  void Fill(EvalReport& report) const {
+  // Everything pooled, then the component metrics of each kept map at its best-F1 threshold.
+  Status Fill(EvalReport& report, int threads) const {
     report.instances = recall_.at("EB").instances();
     report.reported = reported_;
+    report.reported.components = reported_components_.Summary();
+    for (const auto& [variant, store] : component_maps_) {
+      MapComponents& c = report.components[variant];
+      c.level = histograms_.at(variant).BestF1Level();
+      if (c.level < 0) continue;  // no obstacle pixel: no threshold of best F1
+      Result<ComponentSummary> measured = store.Measure(c.level, threads);
+      if (!measured.ok()) return measured.status().WithContext(variant);
+      c.summary = std::move(measured).value();
+    }
     report.free_space = road_labelled_ && not_obstacle_
                             ? "mixed: the road label where the frame has one, else every non-void "
                               "non-obstacle pixel"
@@ -124,6 +145,7 @@ class EvalTotals {
       report.stage_median_ms.emplace_back(stage,
                                           times == stage_ms_.end() ? 0.0 : Median(times->second));
     }
+    return Status::Ok();
   }
 
  private:
@@ -131,7 +153,9 @@ class EvalTotals {
   std::map<std::string, RecallAccumulator> recall_;
   std::map<std::string, PixelRocAccumulator> roc_;
   std::map<std::string, PixelHistogramAccumulator> histograms_;  // AP, FPR95
+  std::map<std::string, ComponentMapStore> component_maps_;
   ReportedObstacleCounts reported_;
+  ComponentAccumulator reported_components_;
   bool road_labelled_ = false, not_obstacle_ = false;
   std::vector<std::string> stage_order_;
   std::map<std::string, std::vector<double>> stage_ms_;
@@ -171,7 +195,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   report.calibration_flat = bundle.params.obstacle_calibration.flat;
   report.proposal_features = bundle.ordr.num_features();
   report.proposal_feature_set = ProposalFeatureSet(bundle.params);
-  totals.Fill(report);
+  if (Status st = totals.Fill(report, options.threads); !st.ok()) return st;
   return report;
 }
 
@@ -180,6 +204,37 @@ std::vector<std::string> PixelMapVariants(const EvalReport& report) {
   if (report.roc.count(kCalibratedMapVariant)) variants.push_back(kCalibratedMapVariant);
   return variants;
 }
+
+std::vector<std::string> ComponentMapVariants(const EvalReport& report) {
+  std::vector<std::string> variants;
+  for (const auto& [variant, c] : report.components) variants.push_back(variant);
+  return variants;
+}
+
+namespace {
+
+nlohmann::json ComponentsToJson(const ComponentSummary& c) {
+  nlohmann::json f1 = nlohmann::json::object();
+  for (std::size_t i = 0; i < c.f1.size(); ++i)
+    f1[Fixed(ComponentF1Thresholds()[i], 2)] = NumberOrNull(c.f1[i]);
+  return {{"truth_components", c.truth_components},
+          {"predicted_components", c.predicted_components},
+          {"mean_siou", NumberOrNull(c.mean_siou)},
+          {"mean_ppv", NumberOrNull(c.mean_ppv)},
+          {"mean_f1", NumberOrNull(c.mean_f1)},
+          {"f1_at_050", NumberOrNull(c.f1_at_050)},
+          {"f1", f1}};
+}
+
+nlohmann::json MapComponentsToJson(const MapComponents& c) {
+  if (c.level < 0) return nullptr;
+  nlohmann::json j = ComponentsToJson(c.summary);
+  j["threshold"] = c.level / 255.0;
+  j["threshold_8bit"] = c.level;
+  return j;
+}
+
+}  // namespace
 
 nlohmann::json EvalReportToJson(const EvalReport& r) {
   nlohmann::json j;
@@ -196,7 +251,14 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
                     {"false_alarms_per_obstacle_free_frame",
                      per(a.false_alarms_on_obstacle_free, a.obstacle_free_frames)},
                     {"instances_found", per(a.instances_found, r.instances)},
+                    {"found_iou25", per(a.found_iou25, r.instances)},
+                    {"found_iou50", per(a.found_iou50, r.instances)},
+                    {"components", ComponentsToJson(a.components)},
                     {"calibration_flat", r.calibration_flat}};
+  // SMIYC component metrics of the served map (BP+Fusion@4) at the split's best pixel F1.
+  j["components"] = nullptr;
+  if (const auto c = r.components.find(kServedMapVariant); c != r.components.end())
+    j["components"] = MapComponentsToJson(c->second);
   j["free_space"] = r.free_space;
   j["map_isolation_exponent"] = r.map_isolation_exponent;
   j["map_superpixel_shares"] = r.map_superpixel_shares;
@@ -225,7 +287,10 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
         {"boxes", "BP+Fusion@4"},
         {"tpr_at_fpr", tpr},
         {"ap", NumberOrNull(r.average_precision.at(kCalibratedMapVariant))},
-        {"fpr_at_tpr95", NumberOrNull(r.fpr_at_tpr95.at(kCalibratedMapVariant))}};
+        {"fpr_at_tpr95", NumberOrNull(r.fpr_at_tpr95.at(kCalibratedMapVariant))},
+        {"components", r.components.count(kCalibratedMapVariant)
+                           ? MapComponentsToJson(r.components.at(kCalibratedMapVariant))
+                           : nlohmann::json()}};
   }
   j["timing_ms"] = nlohmann::json::object();
   for (const auto& [stage, ms] : r.stage_median_ms) j["timing_ms"][stage] = ms;
@@ -248,17 +313,16 @@ void FormatEvalSummary(const EvalReport& r, std::ostringstream& o) {
   o << "regressors: " << r.proposal_features << " proposal features (" << r.proposal_feature_set
     << ")\n";
   const ReportedObstacleCounts& a = r.reported;
-  char text[256];
+  const auto share = [](int count, int of) { return of ? static_cast<double>(count) / of : 0.0; };
+  char text[512];
   std::snprintf(text, sizeof text,
                 "reported obstacles (score >= %.2f): %.2f false alarms per frame, %.2f per "
-                "obstacle-free frame (%d such frames), %.2f of instances found\n",
-                DetectOptions{}.min_obstacle_score,
-                r.frames ? static_cast<double>(a.false_alarms) / r.frames : 0.0,
-                a.obstacle_free_frames
-                    ? static_cast<double>(a.false_alarms_on_obstacle_free) / a.obstacle_free_frames
-                    : 0.0,
-                a.obstacle_free_frames,
-                r.instances ? static_cast<double>(a.instances_found) / r.instances : 0.0);
+                "obstacle-free frame (%d such frames); instances found %.2f at box IoU >= 0.5, "
+                "%.2f at >= 0.25, %.2f overlapped\n",
+                DetectOptions{}.min_obstacle_score, share(a.false_alarms, r.frames),
+                share(a.false_alarms_on_obstacle_free, a.obstacle_free_frames),
+                a.obstacle_free_frames, share(a.found_iou50, r.instances),
+                share(a.found_iou25, r.instances), share(a.instances_found, r.instances));
   o << text;
   if (r.calibration_flat)
     o << "obstacle calibration is flat: on its training frames the fused scores did not rank "
@@ -306,6 +370,32 @@ void FormatPixelTables(const EvalReport& r, std::ostringstream& o) {
       << ": the calibrated map of BP+Fusion@4's boxes, not divided by the frame's maximum)\n";
 }
 
+// SMIYC's component metrics: each map at its best-F1 threshold, then the reported obstacles.
+void FormatComponentTable(const EvalReport& r, std::ostringstream& o) {
+  o << "\nComponent metrics (SegmentMeIfYouCan obstacle track)\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%-22s %9s %6s %6s %6s %6s %6s %6s\n", "prediction",
+                "threshold", "GT", "pred", "sIoU", "PPV", "F1", "F1@0.5");
+  o << line;
+  const auto defined = [](double v) { return std::isnan(v) ? std::string("n/a") : Fixed(v); };
+  const auto row = [&](const std::string& name, const std::string& threshold,
+                       const ComponentSummary& c) {
+    std::snprintf(line, sizeof line, "%-22s %9s %6d %6d %6s %6s %6s %6s\n", name.c_str(),
+                  threshold.c_str(), c.truth_components, c.predicted_components,
+                  defined(c.mean_siou).c_str(), defined(c.mean_ppv).c_str(),
+                  defined(c.mean_f1).c_str(), defined(c.f1_at_050).c_str());
+    o << line;
+  };
+  for (const auto& [variant, c] : r.components) {
+    if (c.level < 0) {
+      o << variant << ": no obstacle pixel, no threshold of best F1\n";
+      continue;
+    }
+    row(variant, Fixed(c.level / 255.0), c.summary);
+  }
+  row("reported obstacles", "-", r.reported.components);
+}
+
 }  // namespace
 
 std::string FormatEvalTables(const EvalReport& r) {
@@ -318,6 +408,7 @@ std::string FormatEvalTables(const EvalReport& r) {
   o << line;
   for (const auto& v : ProposalVariants()) FormatRecallRow(v, r.proposals.at(v), o);
   FormatPixelTables(r, o);
+  FormatComponentTable(r, o);
   o << "\nAverage recall (regressed, score > 0.25)\n";
   for (const auto& v : RegressionVariants()) FormatRecallRow(v, r.regression.at(v), o);
   o << "\nMedian time per frame (ms)\n";

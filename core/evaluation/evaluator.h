@@ -13,6 +13,7 @@
 
 #include "core/datasets/dataset_selection.h"
 #include "core/evaluation/frame_evaluation.h"
+#include "core/metrics/component_metrics.h"
 #include "core/metrics/pixel_histogram_metrics.h"
 #include "core/metrics/pixel_roc.h"
 #include "core/pipeline/model_bundle.h"
@@ -41,6 +42,15 @@ struct ReportedObstacleCounts {
   int obstacle_free_frames = 0;
   int false_alarms_on_obstacle_free = 0;
   int instances_found = 0;  // ground-truth instances overlapped by a reported obstacle
+  int found_iou25 = 0;      // ... matched by a reported box at box IoU >= 0.25
+  int found_iou50 = 0;      // ... at box IoU >= 0.5
+  ComponentSummary components;  // SMIYC components of the reported obstacles' pixels
+};
+
+// SMIYC's component metrics of one map variant, binarised at the split's best pixel F1.
+struct MapComponents {
+  int level = -1;  // the 8-bit threshold (v >= level); -1 without an obstacle pixel
+  ComponentSummary summary;
 };
 
 struct EvalReport {
@@ -71,6 +81,8 @@ struct EvalReport {
   std::map<std::string, double> average_precision;
   std::map<std::string, double> fpr_at_tpr95;
   std::map<std::string, PrecisionRecallCurve> precision_recall;
+  // Per ComponentMapVariants(): the paper's served map and the calibrated map when evaluated.
+  std::map<std::string, MapComponents> components;
   std::vector<std::pair<std::string, double>> stage_median_ms;  // detector stages + "total"
 };
 
@@ -79,6 +91,10 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
 // The variants with pixel metrics in `report`: RegressionVariants(), then kCalibratedMapVariant
 // when it was evaluated.
 std::vector<std::string> PixelMapVariants(const EvalReport& report);
+
+// The map variants with component metrics: BP+Fusion@4 (the map `tod detect` serves by default)
+// and kCalibratedMapVariant when it was evaluated.
+std::vector<std::string> ComponentMapVariants(const EvalReport& report);
 
 // The JSON of the issue: {"frames","instances","proposals":{V:{"ar":{...}}},
 // "regression":{V:{"tpr_at_fpr":{...},"ar":{...},"ap":x,"fpr_at_tpr95":x}},

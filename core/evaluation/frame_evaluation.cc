@@ -1,5 +1,8 @@
 #include "core/evaluation/frame_evaluation.h"
 
+#include <algorithm>
+
+#include "core/evaluation/component_evaluation.h"
 #include "core/evaluation/edge_boxes_baseline.h"
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
@@ -116,18 +119,31 @@ Status AddRegressionVariants(const ModelBundle& bundle, const Sample& s, const F
 }
 
 // The obstacles the detector reports at its defaults (calibrated score >= 0.5): false alarms
-// (no ground-truth obstacle pixel in the box) and the ground-truth instances some reported box
-// overlaps.
-void CountReportedObstacles(const Sample& s, const std::vector<DetectedObstacle>& reported,
-                            FrameEvaluation& out) {
+// (no ground-truth obstacle pixel in the box), the ground-truth instances some reported box
+// overlaps or matches at box IoU 0.25 / 0.5, and the components of the reported pixels.
+Status MeasureReportedObstacles(const Sample& s, const FrameTrace& trace,
+                                const std::vector<DetectedObstacle>& reported,
+                                FrameEvaluation& out) {
   for (const DetectedObstacle& o : reported)
     out.false_alarms += cv::countNonZero(s.obstacle(o.box.rect())) == 0;
-  for (const ObstacleInstance& inst : s.instances)
-    for (const DetectedObstacle& o : reported)
-      if (!Intersect(o.box, inst.box).empty()) {
-        ++out.instances_found;
-        break;
-      }
+  for (const ObstacleInstance& inst : s.instances) {
+    bool overlaps = false;
+    double best_iou = 0;
+    for (const DetectedObstacle& o : reported) {
+      overlaps = overlaps || !Intersect(o.box, inst.box).empty();
+      best_iou = std::max(best_iou, BoxIoU(o.box, inst.box));
+    }
+    out.instances_found += overlaps;
+    out.found_iou25 += best_iou >= 0.25;
+    out.found_iou50 += best_iou >= 0.5;
+  }
+  const cv::Mat1b pixels =
+      ReportedObstaclePixels(trace.components, DetectOptions{}.obstacle_threshold, reported);
+  Result<FrameComponents> components =
+      MeasureComponents(pixels, s.obstacle, ComponentVoidMask(s));
+  if (!components.ok()) return components.status();
+  out.reported_components = std::move(components).value();
+  return Status::Ok();
 }
 
 }  // namespace
@@ -146,7 +162,8 @@ Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sa
   Result<std::vector<ScoredBox>> op_ordr = AddSingleStrideVariants(bundle, sample, trace, out);
   if (!op_ordr.ok()) return op_ordr.status();
   if (Status st = AddRegressionVariants(bundle, sample, trace, *op_ordr, out); !st.ok()) return st;
-  CountReportedObstacles(sample, path->detection.obstacles, out);
+  if (Status st = MeasureReportedObstacles(sample, trace, path->detection.obstacles, out); !st.ok())
+    return st;
   return out;
 }
 

@@ -106,4 +106,20 @@ PrecisionRecallCurve PixelHistogramAccumulator::PrCurve() const {
   return curve;
 }
 
+int PixelHistogramAccumulator::BestF1Level() const {
+  if (positive_total_ == 0) return -1;
+  int best_level = -1;
+  double best_f1 = -1.0;
+  for (const OperatingPoint& point : OperatingPoints()) {
+    // F1 = 2 TP / (2 TP + FP + FN), FN = P - TP.
+    const double f1 = Ratio(2 * point.true_positives,
+                            point.true_positives + point.false_positives + positive_total_);
+    if (f1 > best_f1) {
+      best_f1 = f1;
+      best_level = point.level;
+    }
+  }
+  return best_level;
+}
+
 }  // namespace tod

@@ -47,6 +47,10 @@ class PixelHistogramAccumulator {
   double FprAtTpr(double target_tpr) const;
   // Empty when there is no positive pixel (recall undefined).
   PrecisionRecallCurve PrCurve() const;
+  // The threshold level t of the best pixel F1 = 2PR / (P + R) (ties: the highest level), the
+  // operating point SegmentMeIfYouCan binarises a map at for its component metrics; -1 when
+  // there is no positive pixel.
+  int BestF1Level() const;
 
   std::int64_t positive_pixels() const { return positive_total_; }
   std::int64_t negative_pixels() const { return negative_total_; }

@@ -37,6 +37,10 @@ struct DetectOptions {
   // Components whose calibrated score (DetectedObstacle::score) is below this are not reported:
   // an empty road reports no obstacle.
   float min_obstacle_score = 0.5f;
+  // Components of fewer pixels are not reported either: the obstacle benchmarks void ground-truth
+  // components under 10 px (SegmentMeIfYouCan), so a smaller one can match no obstacle, and a
+  // single pixel over the threshold (a peak where box corners stack) is not an obstacle.
+  int min_obstacle_area = 10;
   bool want_probability_map = true;
   MapKind map_kind = MapKind::kNormalized;
   // Frame budget in ms from the Detect call (frame_budget.h): past its stage shares, proposals

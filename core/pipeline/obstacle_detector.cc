@@ -15,6 +15,7 @@ std::vector<DetectedObstacle> ScoreObstacles(const cv::Mat1f& probability,
                                              const DetectOptions& options) {
   std::vector<DetectedObstacle> out;
   for (const ObstacleComponent& c : ThresholdObstacles(probability, options.obstacle_threshold)) {
+    if (c.area < options.min_obstacle_area) continue;
     const float evidence = ObstacleEvidence(c.box, map_boxes);
     const float score = static_cast<float>(CalibratedScore(params.obstacle_calibration, evidence));
     if (score < options.min_obstacle_score) continue;

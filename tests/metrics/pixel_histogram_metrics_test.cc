@@ -78,6 +78,14 @@ TEST(PixelHistogramMetrics, HandComputedMixedRanking) {
   EXPECT_EQ(pr.precision[3], 0.5);
 }
 
+TEST(PixelHistogramMetrics, BestF1LevelOfTheMixedRanking) {
+  // Same ranking: F1 = 2TP / (TP + FP + P) is 2/3 at t = 204, 1/2 at 102, 4/5 at 89, 2/3 at 25.
+  EXPECT_EQ(Accumulate({{89, 204}, {25, 102}, {}}).BestF1Level(), 89);
+  // Ties go to the higher level: 2/3 at 204 (TP 1) and at 25 (TP 2, FP 2).
+  EXPECT_EQ(Accumulate({{25, 204}, {25, 25}, {}}).BestF1Level(), 204);
+  EXPECT_EQ(Accumulate({{}, {25, 102}, {}}).BestF1Level(), -1);  // no positive pixel
+}
+
 TEST(PixelHistogramMetrics, TiedValuesAreOneThreshold) {
   // A positive and a negative share level 128: one operating point (P 2/3 at R 1), never
   // the positive first (which would give AP 1) nor the negative first.
