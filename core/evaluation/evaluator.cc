@@ -374,8 +374,8 @@ void FormatPixelTables(const EvalReport& r, std::ostringstream& o) {
 void FormatComponentTable(const EvalReport& r, std::ostringstream& o) {
   o << "\nComponent metrics (SegmentMeIfYouCan obstacle track)\n";
   char line[256];
-  std::snprintf(line, sizeof line, "%-22s %9s %6s %6s %6s %6s %6s %6s\n", "prediction",
-                "threshold", "GT", "pred", "sIoU", "PPV", "F1", "F1@0.5");
+  std::snprintf(line, sizeof line, "%-22s %9s %6s %6s %6s %6s %6s %6s\n", "prediction", "threshold",
+                "GT", "pred", "sIoU", "PPV", "F1", "F1@0.5");
   o << line;
   const auto defined = [](double v) { return std::isnan(v) ? std::string("n/a") : Fixed(v); };
   const auto row = [&](const std::string& name, const std::string& threshold,

@@ -41,9 +41,9 @@ struct ReportedObstacleCounts {
   int false_alarms = 0;
   int obstacle_free_frames = 0;
   int false_alarms_on_obstacle_free = 0;
-  int instances_found = 0;  // ground-truth instances overlapped by a reported obstacle
-  int found_iou25 = 0;      // ... matched by a reported box at box IoU >= 0.25
-  int found_iou50 = 0;      // ... at box IoU >= 0.5
+  int instances_found = 0;      // ground-truth instances overlapped by a reported obstacle
+  int found_iou25 = 0;          // ... matched by a reported box at box IoU >= 0.25
+  int found_iou50 = 0;          // ... at box IoU >= 0.5
   ComponentSummary components;  // SMIYC components of the reported obstacles' pixels
 };
 

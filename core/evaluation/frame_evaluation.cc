@@ -139,8 +139,7 @@ Status MeasureReportedObstacles(const Sample& s, const FrameTrace& trace,
   }
   const cv::Mat1b pixels =
       ReportedObstaclePixels(trace.components, DetectOptions{}.obstacle_threshold, reported);
-  Result<FrameComponents> components =
-      MeasureComponents(pixels, s.obstacle, ComponentVoidMask(s));
+  Result<FrameComponents> components = MeasureComponents(pixels, s.obstacle, ComponentVoidMask(s));
   if (!components.ok()) return components.status();
   out.reported_components = std::move(components).value();
   return Status::Ok();

@@ -56,7 +56,8 @@ Result<FrameComponents> MeasureComponents(const cv::Mat1b& predicted, const cv::
                                           const cv::Mat1b& void_mask,
                                           const ComponentMetricsParams& params) {
   if (predicted.size() != truth.size() || void_mask.size() != truth.size())
-    return Status::InvalidArgument("MeasureComponents: prediction, truth and void masks differ in size");
+    return Status::InvalidArgument(
+        "MeasureComponents: prediction, truth and void masks differ in size");
   // Ground truth: obstacle pixels in the region of interest; small components become void.
   const cv::Mat1b truth_in_roi = (truth != 0) & (void_mask == 0);
   Components all_truth = Label(truth_in_roi);
@@ -70,7 +71,8 @@ Result<FrameComponents> MeasureComponents(const cv::Mat1b& predicted, const cv::
   // Pair counts |K ∩ P| for every ground-truth K and predicted P that overlap, and per predicted
   // component its pixels on any ground truth.
   const int n_gt = gt.count(), n_pred = pred.count();
-  std::vector<std::vector<std::int64_t>> overlap(n_gt + 1, std::vector<std::int64_t>(n_pred + 1, 0));
+  std::vector<std::vector<std::int64_t>> overlap(n_gt + 1,
+                                                 std::vector<std::int64_t>(n_pred + 1, 0));
   for (int y = 0; y < gt.labels.rows; ++y) {
     const int* g = gt.labels[y];
     const int* p = pred.labels[y];

@@ -44,8 +44,8 @@ const std::vector<double>& ComponentF1Thresholds();
 struct ComponentSummary {
   int truth_components = 0;
   int predicted_components = 0;
-  double mean_siou = 0;  // NaN without ground-truth components
-  double mean_ppv = 0;   // NaN without predicted components
+  double mean_siou = 0;    // NaN without ground-truth components
+  double mean_ppv = 0;     // NaN without predicted components
   std::vector<double> f1;  // per ComponentF1Thresholds(); NaN when TP + FN + FP = 0
   double mean_f1 = 0;
   double f1_at_050 = 0;

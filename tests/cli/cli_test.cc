@@ -219,6 +219,21 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
     EXPECT_FALSE(cv::imread((out_ / "plots" / png).string()).empty()) << png;
   // The printed table carries them too.
   EXPECT_NE(run.output.find("Pixel AP and FPR at 95 % TPR"), std::string::npos) << run.output;
+  // SegmentMeIfYouCan's component metrics of the served map, and the obstacle list's.
+  EXPECT_NE(run.output.find("Component metrics (SegmentMeIfYouCan"), std::string::npos);
+  ASSERT_TRUE(j["components"].is_object()) << j.dump();
+  EXPECT_GT(j["components"]["truth_components"].get<int>(), 0);
+  for (const char* m : {"mean_siou", "mean_f1", "f1_at_050", "threshold"}) {
+    ASSERT_TRUE(j["components"][m].is_number()) << m;
+    EXPECT_GE(j["components"][m].get<double>(), 0.0) << m;
+    EXPECT_LE(j["components"][m].get<double>(), 1.0) << m;
+  }
+  EXPECT_EQ(j["components"]["f1"].size(), 11u);
+  for (const char* m : {"found_iou50", "found_iou25", "instances_found"})
+    ASSERT_TRUE(j["obstacles"][m].is_number()) << m;
+  EXPECT_LE(j["obstacles"]["found_iou50"].get<double>(),
+            j["obstacles"]["found_iou25"].get<double>());
+  EXPECT_TRUE(j["obstacles"]["components"].contains("mean_f1"));
   // Which map the pixel metrics were measured on: the bundle's isolation exponent.
   std::ifstream manifest_in(fs::path(model_) / "manifest.json");
   const nlohmann::json manifest = nlohmann::json::parse(manifest_in);
