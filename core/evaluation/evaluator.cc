@@ -88,15 +88,16 @@ class EvalTotals {
       if (kept == component_maps_.end()) continue;
       if (Status st = kept->second.Add(map, s); !st.ok()) return st.WithContext(variant);
     }
-    reported_.false_alarms += frame.false_alarms;
-    reported_.instances_found += frame.instances_found;
-    reported_.found_iou25 += frame.found_iou25;
-    reported_.found_iou50 += frame.found_iou50;
+    reported_.false_alarms += frame.reported.false_alarms;
+    reported_.instances_found += frame.reported.instances_found;
+    reported_.found_iou25 += frame.reported.found_iou25;
+    reported_.found_iou50 += frame.reported.found_iou50;
     reported_components_.Add(frame.reported_components);
     if (s.instances.empty()) {
       ++reported_.obstacle_free_frames;
-      reported_.false_alarms_on_obstacle_free += frame.false_alarms;
+      reported_.false_alarms_on_obstacle_free += frame.reported.false_alarms;
     }
+    for (const auto& [rule, counts] : frame.list_sweep) list_sweep_[rule] += counts;
     (s.free_space == FreeSpace::kRoadLabel ? road_labelled_ : not_obstacle_) = true;
     std::vector<Box> gt;
     for (const auto& inst : s.instances) gt.push_back(inst.box);
@@ -114,6 +115,7 @@ class EvalTotals {
     report.instances = recall_.at("EB").instances();
     report.reported = reported_;
     report.reported.components = reported_components_.Summary();
+    report.list_sweep = list_sweep_;
     for (const auto& [variant, store] : component_maps_) {
       MapComponents& c = report.components[variant];
       c.level = histograms_.at(variant).BestF1Level();
@@ -156,6 +158,7 @@ class EvalTotals {
   std::map<std::string, ComponentMapStore> component_maps_;
   ReportedObstacleCounts reported_;
   ComponentAccumulator reported_components_;
+  std::map<std::string, ObstacleListCounts> list_sweep_;
   bool road_labelled_ = false, not_obstacle_ = false;
   std::vector<std::string> stage_order_;
   std::map<std::string, std::vector<double>> stage_ms_;
@@ -255,6 +258,7 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
                     {"found_iou50", per(a.found_iou50, r.instances)},
                     {"components", ComponentsToJson(a.components)},
                     {"calibration_flat", r.calibration_flat}};
+  j["obstacle_sweep"] = ObstacleListSweepToJson(r.list_sweep, r.instances, r.frames);
   // SMIYC component metrics of the served map (BP+Fusion@4) at the split's best pixel F1.
   j["components"] = nullptr;
   if (const auto c = r.components.find(kServedMapVariant); c != r.components.end())
@@ -409,6 +413,7 @@ std::string FormatEvalTables(const EvalReport& r) {
   for (const auto& v : ProposalVariants()) FormatRecallRow(v, r.proposals.at(v), o);
   FormatPixelTables(r, o);
   FormatComponentTable(r, o);
+  o << "\n" << FormatObstacleListSweep(r.list_sweep, r.instances, r.frames);
   o << "\nAverage recall (regressed, score > 0.25)\n";
   for (const auto& v : RegressionVariants()) FormatRecallRow(v, r.regression.at(v), o);
   o << "\nMedian time per frame (ms)\n";

@@ -57,6 +57,8 @@ struct EvalReport {
   int frames = 0;  // evaluated (skipped ones not counted)
   std::vector<SkippedFrame> skipped;
   ReportedObstacleCounts reported;
+  // The obstacle list under other reporting rules (obstacle_list_sweep.h), summed over the split.
+  std::map<std::string, ObstacleListCounts> list_sweep;
   // What the pixel metrics' negatives are: "road label" (LAF free space, MODDv2 water) or
   // "every non-void pixel that is not an obstacle" (mask benchmarks without a road label).
   std::string free_space;

@@ -4,6 +4,7 @@
 
 #include "core/evaluation/component_evaluation.h"
 #include "core/evaluation/edge_boxes_baseline.h"
+#include "core/evaluation/obstacle_list_sweep.h"
 #include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/frame_stages.h"
 #include "core/pipeline/obstacle_detector.h"
@@ -124,19 +125,9 @@ Status AddRegressionVariants(const ModelBundle& bundle, const Sample& s, const F
 Status MeasureReportedObstacles(const Sample& s, const FrameTrace& trace,
                                 const std::vector<DetectedObstacle>& reported,
                                 FrameEvaluation& out) {
-  for (const DetectedObstacle& o : reported)
-    out.false_alarms += cv::countNonZero(s.obstacle(o.box.rect())) == 0;
-  for (const ObstacleInstance& inst : s.instances) {
-    bool overlaps = false;
-    double best_iou = 0;
-    for (const DetectedObstacle& o : reported) {
-      overlaps = overlaps || !Intersect(o.box, inst.box).empty();
-      best_iou = std::max(best_iou, BoxIoU(o.box, inst.box));
-    }
-    out.instances_found += overlaps;
-    out.found_iou25 += best_iou >= 0.25;
-    out.found_iou50 += best_iou >= 0.5;
-  }
+  std::vector<Box> boxes;
+  for (const DetectedObstacle& o : reported) boxes.push_back(o.box);
+  out.reported = CountObstacleList(s, boxes);
   const cv::Mat1b pixels =
       ReportedObstaclePixels(trace.components, DetectOptions{}.obstacle_threshold, reported);
   Result<FrameComponents> components = MeasureComponents(pixels, s.obstacle, ComponentVoidMask(s));
@@ -163,6 +154,11 @@ Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sa
   if (Status st = AddRegressionVariants(bundle, sample, trace, *op_ordr, out); !st.ok()) return st;
   if (Status st = MeasureReportedObstacles(sample, trace, path->detection.obstacles, out); !st.ok())
     return st;
+  const auto calibrated = std::find_if(out.maps.begin(), out.maps.end(), [](const auto& m) {
+    return m.first == kCalibratedMapVariant;
+  });
+  out.list_sweep = SweepObstacleLists(sample, trace, bundle.params,
+                                      calibrated == out.maps.end() ? nullptr : &calibrated->second);
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include "core/base/stage_timer.h"
 #include "core/base/status.h"
 #include "core/base/types.h"
+#include "core/evaluation/obstacle_list_sweep.h"
 #include "core/metrics/component_metrics.h"
 #include "core/pipeline/obstacle_detector.h"
 
@@ -44,11 +45,10 @@ struct FrameEvaluation {
   // then kCalibratedMapVariant when the bundle has a fitted calibration.
   std::vector<std::pair<std::string, cv::Mat1f>> maps;
   // The obstacles the detector reports at its defaults (DetectOptions{}).
-  int false_alarms = 0;                 // reported obstacles without a ground-truth obstacle pixel
-  int instances_found = 0;              // ground-truth instances that a reported obstacle overlaps
-  int found_iou25 = 0;                  // ... that a reported box matches at box IoU >= 0.25
-  int found_iou50 = 0;                  // ... at box IoU >= 0.5
+  ObstacleListCounts reported;
   FrameComponents reported_components;  // SMIYC components of the reported obstacles' pixels
+  // The same counts under other reporting rules (obstacle_list_sweep.h).
+  std::map<std::string, ObstacleListCounts> list_sweep;
   // The detector's path (edges to the BP+Fusion map), timed stage by stage; the baselines and
   // the other variants run outside it.
   StageTimes stage_times;

@@ -231,7 +231,12 @@ std::string FormatCrossValidation(const CrossValidationReport& report) {
       {"calibrated_map/ap", "served map pixel AP"},
       {"regression/BP+Fusion@4/ar/1000", "BP+Fusion AR@1000"},
       {"proposals/OAOCC+OLP@4+MS/ar/1000", "proposals AR@1000"},
-      {"obstacles/instances_found", "obstacles found"},
+      {"components/mean_f1", "SMIYC mean F1 (map)"},
+      {"calibrated_map/components/mean_f1", "SMIYC mean F1 (cal map)"},
+      {"obstacles/found_iou50", "obstacles found IoU 0.5"},
+      {"obstacles/found_iou25", "obstacles found IoU 0.25"},
+      {"obstacles/instances_found", "obstacles overlapped"},
+      {"obstacles/components/mean_f1", "SMIYC mean F1 (list)"},
       {"obstacles/false_alarms_per_frame", "false alarms / frame"},
   };
   const std::vector<std::map<std::string, double>> per_fold = PerFoldMeans(report);

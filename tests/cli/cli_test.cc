@@ -234,6 +234,13 @@ TEST_F(CliTest, EvalPrintsAllEightVariantsAndWritesJsonAndPlots) {
   EXPECT_LE(j["obstacles"]["found_iou50"].get<double>(),
             j["obstacles"]["found_iou25"].get<double>());
   EXPECT_TRUE(j["obstacles"]["components"].contains("mean_f1"));
+  // The reporting-rule sweep: its row of the detector's defaults is the served list itself.
+  EXPECT_NE(run.output.find("Obstacle list by reporting rule"), std::string::npos);
+  const nlohmann::json& served_rule = j["obstacle_sweep"]["components@0.50"]["0.50"];
+  ASSERT_TRUE(served_rule.is_object()) << j["obstacle_sweep"].dump();
+  for (const char* m : {"found_iou50", "found_iou25", "instances_found", "false_alarms_per_frame"})
+    EXPECT_DOUBLE_EQ(served_rule[m].get<double>(), j["obstacles"][m].get<double>()) << m;
+  EXPECT_TRUE(j["obstacle_sweep"]["boxes"].contains("0.50"));
   // Which map the pixel metrics were measured on: the bundle's isolation exponent.
   std::ifstream manifest_in(fs::path(model_) / "manifest.json");
   const nlohmann::json manifest = nlohmann::json::parse(manifest_in);
