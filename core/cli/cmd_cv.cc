@@ -1,4 +1,5 @@
 // tod cv --data DIR --work DIR [--folds 5] [--seeds 1] [--seed S] [--paper NAME] [--json FILE]
+//        [--keep-models | --reuse-models]
 // Cross-validates the training recipe (tod train's defaults) over K folds of consecutive frames
 // and N seeds (core/validation/cross_validation.h): trains on K-1 folds, evaluates on the one
 // left out, and prints the headline metrics per fold with their mean and min-max spread; the
@@ -46,6 +47,10 @@ Runner AddCvCommand(CLI::App& app) {
   AddPaperOption(cmd, args->paper);
   cmd->add_option("--threads", args->recipe.threads, "worker threads (0 = all cores)");
   cmd->add_flag("--keep-models", args->cv.keep_models, "keep every fold's bundle under --work");
+  cmd->add_flag("--reuse-models", args->cv.reuse_models,
+                "evaluate the bundles --keep-models left under --work instead of training "
+                "(the same models under other detection options or evaluation code)")
+      ->excludes("--keep-models");
   cmd->add_option("--json", args->json, "write every number under \"cv\" to this file");
   return [args] {
     BoundOpenCvThreads(args->recipe.threads);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -68,10 +70,42 @@ void Say(const CrossValidationOptions& options, const std::string& line) {
   if (options.progress) options.progress(line);
 }
 
-// One fold under one seed: train on the other folds, evaluate on this one.
-Result<nlohmann::json> RunFold(const TrainOptions& recipe, const EvalOptions& eval,
-                               const CrossValidationOptions& options, const std::string& split,
-                               const std::string& model_dir, std::uint64_t seed) {
+// Beside a kept bundle: the fold's split file it was trained on.
+constexpr const char* kKeptSplitName = "cv-split.txt";
+
+std::string ReadWholeFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return in ? std::string(std::istreambuf_iterator<char>(in), {}) : std::string();
+}
+
+// The bundle a keep_models run left in `model_dir`, if it was trained on this fold's split (the
+// split file kept beside it) with `seed` (its manifest) on the recipe's data.
+Result<ModelBundle> LoadKeptFoldBundle(const std::string& model_dir, const TrainOptions& recipe,
+                                       const std::string& split, std::uint64_t seed) {
+  const std::string kept_split = ReadWholeFile(fs::path(model_dir) / kKeptSplitName);
+  if (kept_split.empty())
+    return Status::NotFound("no kept bundle in " + model_dir +
+                            " (run tod cv with --keep-models first)");
+  auto bundle = LoadModelBundle(model_dir);
+  if (!bundle.ok()) return bundle.status();
+  std::ifstream in(fs::path(model_dir) / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  const nlohmann::json training =
+      manifest.is_object() ? manifest.value("training", nlohmann::json()) : nlohmann::json();
+  if (kept_split != ReadWholeFile(split) || !training.is_object() ||
+      training.value("seed", std::uint64_t{0}) != seed ||
+      training.value("data", std::string()) != recipe.data.data_root)
+    return Status::FailedPrecondition(model_dir + " was not trained on this fold of " +
+                                      recipe.data.data_root + " with seed " + std::to_string(seed));
+  return bundle;
+}
+
+// This fold's bundle under one seed: trained on the other folds (and kept, with its split file,
+// when asked), or the kept one.
+Result<ModelBundle> FoldBundle(const TrainOptions& recipe, const CrossValidationOptions& options,
+                               const std::string& split, const std::string& model_dir,
+                               std::uint64_t seed) {
+  if (options.reuse_models) return LoadKeptFoldBundle(model_dir, recipe, split, seed);
   TrainOptions train = recipe;
   train.data.split = "train";
   train.data.split_file = split;
@@ -80,7 +114,19 @@ Result<nlohmann::json> RunFold(const TrainOptions& recipe, const EvalOptions& ev
   if (!bundle.ok()) return bundle.status();
   if (options.keep_models) {
     if (Status st = SaveModelBundle(*bundle, model_dir, recipe.sed_model); !st.ok()) return st;
+    const Status st =
+        WriteFileAtomically((fs::path(model_dir) / kKeptSplitName).string(), ReadWholeFile(split));
+    if (!st.ok()) return st;
   }
+  return bundle;
+}
+
+// One fold under one seed: its bundle, evaluated on the fold.
+Result<nlohmann::json> RunFold(const TrainOptions& recipe, const EvalOptions& eval,
+                               const CrossValidationOptions& options, const std::string& split,
+                               const std::string& model_dir, std::uint64_t seed) {
+  auto bundle = FoldBundle(recipe, options, split, model_dir, seed);
+  if (!bundle.ok()) return bundle.status();
   EvalOptions test = eval;
   test.data = recipe.data;
   test.data.split = "test";

@@ -27,6 +27,11 @@ struct CrossValidationOptions {
   // Where each fold's split file (and, with keep_models, its bundle) is written.
   std::string work_dir;
   bool keep_models = false;
+  // Evaluate the bundles an earlier keep_models run left under work_dir instead of training:
+  // detection options and evaluation changes measured on the same models in minutes. A fold's
+  // bundle is refused unless the split file kept beside it is this fold's and its manifest
+  // names this data and seed.
+  bool reuse_models = false;
   std::function<void(const std::string&)> progress;
 };
 

@@ -600,13 +600,14 @@ void ExpectMoreRegressorSamples(const nlohmann::json& with, const nlohmann::json
 }
 
 // `tod cv`: two folds of consecutive frames, each trained on the other and evaluated on itself;
-// per fold and the mean with its spread, under "cv"; a LAF-layout set is refused (its folds
-// cannot be written as split files).
+// per fold and the mean with its spread, under "cv"; the kept bundles evaluated again without
+// training give the same numbers, a bundle of another seed is refused; a LAF-layout set is
+// refused (its folds cannot be written as split files).
 TEST_F(MasksCliTest, CrossValidationOverFoldsOfConsecutiveFrames) {
   const std::string json = (out_ / "cv.json").string();
-  const CommandResult cv = RunCommand(tod_ + " cv --data " + Root() + " --work " +
-                                      (out_ / "cv").string() + " --folds 2 --seeds 1 --trees 4 " +
-                                      "--classifier-frames 4 --threads 2 --json " + json);
+  const std::string common = tod_ + " cv --data " + Root() + " --work " + (out_ / "cv").string() +
+                             " --folds 2 --seeds 1 --trees 4 --classifier-frames 4 --threads 2";
+  const CommandResult cv = RunCommand(common + " --keep-models --json " + json);
   ASSERT_EQ(cv.exit_code, 0) << cv.output;
   EXPECT_NE(cv.output.find("2-fold cross-validation, 1 seed from 1"), std::string::npos)
       << cv.output;
@@ -629,7 +630,22 @@ TEST_F(MasksCliTest, CrossValidationOverFoldsOfConsecutiveFrames) {
   EXPECT_LE(j["min"][ap].get<double>(), j["mean"][ap].get<double>());
   EXPECT_GE(j["max"][ap].get<double>(), j["mean"][ap].get<double>());
   EXPECT_TRUE(fs::exists(out_ / "cv" / "fold1-split.txt"));
-  EXPECT_FALSE(fs::exists(out_ / "cv" / "fold1-seed1"));  // bundles only with --keep-models
+  EXPECT_TRUE(fs::exists(out_ / "cv" / "fold1-seed1" / "manifest.json"));
+
+  const std::string reused_json = (out_ / "cv-reused.json").string();
+  const CommandResult reused = RunCommand(common + " --reuse-models --json " + reused_json);
+  ASSERT_EQ(reused.exit_code, 0) << reused.output;
+  EXPECT_EQ(reused.output.find("train: "), std::string::npos) << reused.output;
+  std::ifstream reused_in(reused_json);
+  const nlohmann::json r = nlohmann::json::parse(reused_in)["cv"];
+  // Every metric but the stage times.
+  for (const auto& [path, value] : j["mean"].items())
+    if (path.rfind("timing_ms/", 0) != 0) {
+      EXPECT_EQ(r["mean"][path], value) << path;
+    }
+  const CommandResult other_seed = RunCommand(common + " --seed 2 --reuse-models");
+  EXPECT_NE(other_seed.exit_code, 0) << other_seed.output;
+  EXPECT_NE(other_seed.output.find("--keep-models"), std::string::npos) << other_seed.output;
 
   const CommandResult laf =
       RunCommand(tod_ + " cv --data " + tod::testing_env::TestData() + " --work " +
