@@ -192,13 +192,20 @@ class Walker {
   Status StructValues(std::string_view data, uint32_t array_class, uint64_t elements,
                       size_t own_bytes, int depth) {
     uint32_t type = 0, size = 0;
-    std::string_view class_name, name_length, names;
+    std::string_view class_name, names;
     if (array_class == kClassObject) {
       if (Status s = Tag(&data, &type, &size, &class_name); !s.ok()) return s;
     }
-    if (Status s = Tag(&data, &type, &size, &name_length); !s.ok()) return s;
-    if (name_length.size() < 4) return Corrupt("struct field name length missing");
-    const uint32_t length = U32(name_length.data());
+    // libmatio reads the field name length as 8 bytes whatever their tag says (as it should be,
+    // a small int32 element), takes the length from bytes 4-7 and reads the names' tag right
+    // after: a fuzzed 424-byte file whose length element was a regular 8-byte one made it read
+    // the length's own value as the names' tag, claiming 4 GB, and allocate a pointer for each
+    // of 516 M field names. The walk reads the two as libmatio does, so Tag checks that claim.
+    if (data.size() < 8) return Corrupt("struct field name length missing");
+    if ((U32(data.data()) & 0xFFFF) != kMiInt32)
+      return Corrupt("struct field name length is not int32");
+    const uint32_t length = U32(data.data() + 4);
+    data.remove_prefix(8);
     if (Status s = Tag(&data, &type, &size, &names); !s.ok()) return s;
     const uint64_t fields = length == 0 ? 0 : names.size() / length;
     return Values(data, elements, fields, own_bytes, depth);

@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets in their own clang build directory and runs each one in turn
 # (docs/service.md#fuzzing).
-#   tests/fuzz/run_fuzzers.sh                 5 seconds per target (what CI runs)
-#   tests/fuzz/run_fuzzers.sh 60              60 seconds per target
+#   tests/fuzz/run_fuzzers.sh --ci            what CI runs: every corpus input replayed, then a
+#                                             fixed-seed exploration of 20000 inputs per target, so
+#                                             that the gate fails only for a reason in the change
+#   tests/fuzz/run_fuzzers.sh 60              60 seconds per target at random (finds new inputs:
+#                                             a finding becomes a corpus entry once fixed)
 #   tests/fuzz/run_fuzzers.sh --runs 1000000 [--max-time 600]   1 M executions per target
 #   tests/fuzz/run_fuzzers.sh --seeds         regenerate tests/fuzz/corpus/ with fuzz_seed_gen
 # Options: --targets "fuzz_a fuzz_b" (default: all), --build-only.
@@ -20,6 +23,8 @@ ALL_TARGETS="fuzz_image_decode fuzz_rest_request fuzz_grpc_request fuzz_model_fi
 
 seconds=5
 runs=""
+seed=()
+ci=0
 max_time=0
 targets=$ALL_TARGETS
 seeds=0
@@ -27,6 +32,7 @@ build_only=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --runs) runs=$2; shift 2 ;;
+    --ci) ci=1; runs=20000; max_time=300; seed=(-seed=1); shift ;;
     --max-time) max_time=$2; shift 2 ;;
     --targets) targets=$2; shift 2 ;;
     --seeds) seeds=1; shift ;;
@@ -82,6 +88,9 @@ failed=()
 summary=()
 for target in $targets; do
   work=$BUILD_DIR/corpus/$target
+  # --ci starts from the project's corpus alone every time: what an earlier run kept would make
+  # the result depend on the build directory's history.
+  [[ $ci -eq 1 ]] && work=$BUILD_DIR/corpus-ci/$target && rm -rf "$work"
   artifacts=$BUILD_DIR/artifacts/$target/
   mkdir -p "$work" "$artifacts"
   dict=()
@@ -93,11 +102,12 @@ for target in $targets; do
     echo "run_fuzzers.sh: $target: $seconds s"
   fi
   status=0
-  nice "$BUILD_DIR/bin/$target" "${common[@]}" "${limit[@]}" "${dict[@]}" \
+  nice "$BUILD_DIR/bin/$target" "${common[@]}" "${seed[@]}" "${limit[@]}" "${dict[@]}" \
     -artifact_prefix="$artifacts" "$work" "tests/fuzz/corpus/$target" >"$log" 2>&1 || status=$?
-  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
-  secs=$(sed -n 's/^Done [0-9]* runs in \([0-9]*\) second.*/\1/p' "$log" | tail -1)
-  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
+  # (|| true: a target that fails before its first status line prints none of these)
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1 || true)
+  secs=$(sed -n 's/^Done [0-9]* runs in \([0-9]*\) second.*/\1/p' "$log" | tail -1 || true)
+  cov=$({ grep -o 'cov: [0-9]*' "$log" || true; } | tail -1 | cut -d' ' -f2)
   if [[ $status -ne 0 ]]; then
     failed+=("$target")
     echo "run_fuzzers.sh: $target FAILED (exit $status); log: $log, input: $(ls -t "$artifacts" | head -1)" >&2

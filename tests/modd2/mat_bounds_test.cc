@@ -104,6 +104,15 @@ TEST(Mat5BoundsTest, FuzzerInputWithOversizedArrayFlagsIsRefusedQuickly) {
   ExpectRefusedQuickly(CorpusInput("crash-21f975afa41a49ca7730a43deb45953b585520f0"));
 }
 
+// A 424-byte mutated seed found by CI's 5 s fuzz_smoke on an unchanged main: the struct's field
+// name length is a regular 8-byte element instead of a small one. libmatio reads 8 bytes for the
+// length whatever their tag, so it took the element's value (1, then 0xf6000001) as the names'
+// tag, 4 GB of names of 8 bytes, and asked malloc for 4.1 GB of pointers; the walk read the
+// length's tag as a whole element and the names from the bytes after it.
+TEST(Mat5BoundsTest, FuzzerInputWithARegularFieldNameLengthElementIsRefusedQuickly) {
+  ExpectRefusedQuickly(CorpusInput("oom-772e0b93"));
+}
+
 // The same cause, constructed: a MAT v4 header (type, rows, columns, complex flag, name length)
 // claiming a 2 GB name, followed by a few bytes.
 TEST(Mat5BoundsTest, MatV4HeaderClaimingAHugeNameIsRefused) {
@@ -210,7 +219,10 @@ TEST(Mat5BoundsTest, StructWhoseElementsTimesFieldsOverflowsIsRefused) {
   element(6, flags);  // miUINT32
   element(5, dims);   // miINT32
   element(1, "s");    // miINT8
-  element(5, name_length);
+  // The field name length as MAT files hold it: a small int32 element (4 bytes in the tag).
+  std::string small(4, '\0');
+  PutU32(&small, 0, (4u << 16) | 5u);
+  matrix += small + name_length;
   element(1, std::string(kFields, 'f'));
   std::string bytes(128, ' ');
   PutU32(&bytes, 124, 0x4D490100);  // version 0x0100, "IM"
