@@ -9,14 +9,15 @@
 namespace tod {
 namespace {
 
-std::string Key(const char* format, const char* rule, float a, float b) {
+// "RULE@T/S" and "boxes/S", two decimals each.
+std::string RuleKey(const char* rule, float threshold, float min_score) {
   char key[64];
-  std::snprintf(key, sizeof key, format, rule, a, b);
+  std::snprintf(key, sizeof key, "%s@%.2f/%.2f", rule, threshold, min_score);
   return key;
 }
-std::string Key(const char* format, float a) {
-  char key[64];
-  std::snprintf(key, sizeof key, format, a);
+std::string BoxesKey(float min_score) {
+  char key[32];
+  std::snprintf(key, sizeof key, "boxes/%.2f", min_score);
   return key;
 }
 
@@ -100,8 +101,7 @@ void SweepComponents(const Sample& sample, const cv::Mat1f& map, const FrameTrac
       std::vector<DetectedObstacle> kept;
       for (const DetectedObstacle& o : scored)
         if (o.score >= min_score) kept.push_back(o);
-      out[Key("%s@%.2f/%.2f", rule, threshold, min_score)] =
-          CountObstacleList(sample, BoxesOf(kept));
+      out[RuleKey(rule, threshold, min_score)] = CountObstacleList(sample, BoxesOf(kept));
     }
   }
 }
@@ -120,7 +120,7 @@ std::map<std::string, ObstacleListCounts> SweepObstacleLists(const Sample& sampl
     SweepComponents(sample, *calibrated, trace, params, "calibrated", grid.calibrated_thresholds,
                     grid.min_scores, out);
   for (const float min_score : grid.min_scores)
-    out[Key("boxes/%.2f", min_score)] = CountObstacleList(
+    out[BoxesKey(min_score)] = CountObstacleList(
         sample, BoxesOf(BoxListObstacles(trace.accumulated.boxes, params, min_score,
                                          DetectOptions{}.min_obstacle_area)));
   return out;
