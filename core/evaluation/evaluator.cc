@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
 #include "core/datasets/dataset_factory.h"
@@ -59,7 +61,7 @@ nlohmann::json NumberOrNull(double v) {
 namespace {
 
 // The split's running totals: recall per variant, pixel counts per map variant, the reported
-// obstacles and the stage times. The caller serialises Add().
+// obstacles and the stage times. The caller serialises Add() and calls it in frame order.
 class EvalTotals {
  public:
   explicit EvalTotals(bool calibrated_map) : map_variants_(RegressionVariants()) {
@@ -164,6 +166,12 @@ class EvalTotals {
   std::map<std::string, std::vector<double>> stage_ms_;
 };
 
+// One frame's evaluation with the sample it was measured on, waiting for its turn in the totals.
+struct EvaluatedFrame {
+  FrameEvaluation evaluation;
+  Sample sample;
+};
+
 }  // namespace
 
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options) {
@@ -173,20 +181,40 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   const int n = static_cast<int>(selection->frames.size());
   EvalTotals totals(bundle.params.obstacle_calibration.fitted);
   const ObstacleDetector detector(bundle, "eval");  // one copy of the bundle for the run
+  // Frames finish in any order, but the totals are added in frame order: pooled floating-point
+  // means (sIoU, PPV) then do not depend on the thread count or on scheduling.
   std::mutex mutex;
-  int done = 0;
-  const std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
-    const auto loaded = dataset.Load(selection->frames[i]);
-    if (!loaded.ok()) return loaded.status();
-    const Result<FrameEvaluation> frame = EvaluateFrame(detector, *loaded);
-    if (!frame.ok()) return frame.status();
+  std::map<int, std::optional<EvaluatedFrame>> finished;  // nullopt: the frame failed
+  std::vector<Status> added(n, Status::Ok());
+  int next_to_add = 0;
+  const auto finish = [&](int i, std::optional<EvaluatedFrame> frame) {
     std::lock_guard lock(mutex);
-    if (Status st = totals.Add(*frame, *loaded); !st.ok()) return st;
-    ++done;
-    if (options.progress && (done % 10 == 0 || done == n))
-      options.progress("evaluated " + std::to_string(done) + "/" + std::to_string(n) + " frames");
+    finished.emplace(i, std::move(frame));
+    for (auto it = finished.find(next_to_add); it != finished.end();
+         it = finished.find(next_to_add)) {
+      if (it->second) added[next_to_add] = totals.Add(it->second->evaluation, it->second->sample);
+      finished.erase(it);
+      ++next_to_add;
+      if (options.progress && (next_to_add % 10 == 0 || next_to_add == n))
+        options.progress("evaluated " + std::to_string(next_to_add) + "/" + std::to_string(n) +
+                         " frames");
+    }
+  };
+  std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
+    Result<Sample> loaded = dataset.Load(selection->frames[i]);
+    Result<FrameEvaluation> frame =
+        loaded.ok() ? EvaluateFrame(detector, *loaded) : Result<FrameEvaluation>(loaded.status());
+    if (!frame.ok()) {
+      finish(i, std::nullopt);
+      return frame.status();
+    }
+    Sample sample = std::move(loaded).value();
+    sample.image.release();  // the totals need the masks only
+    finish(i, EvaluatedFrame{std::move(frame).value(), std::move(sample)});
     return Status::Ok();
   });
+  for (int i = 0; i < n; ++i)
+    if (per_frame[i].ok()) per_frame[i] = added[i];
   EvalReport report;
   const Status bad = ApplyBadFramePolicy(
       per_frame, [&](int i) { return dataset.name(selection->frames[i]); },
