@@ -31,6 +31,9 @@ const std::vector<SettingSpec>& SettingSpecs() {
       {"host", "host", "TOD_HOST", "Bind address for both listeners (default 0.0.0.0)"},
       {"grpc_port", "grpc-port", "TOD_GRPC_PORT", "gRPC port (default 8001)"},
       {"http_port", "http-port", "TOD_HTTP_PORT", "REST port (default 8000)"},
+      {"ports_file", "ports-file", "TOD_PORTS_FILE",
+       "Write the bound ports as JSON {\"grpc\":P,\"http\":P} here once listening (with port 0: "
+       "free ports the kernel picked)"},
       {"workers", "workers", "TOD_WORKERS", "Worker threads (default: number of cores)"},
       {"threads_per_request", "threads-per-request", "TOD_THREADS_PER_REQUEST",
        "Cores one request may use: window scans, features and regressors split over them "
@@ -69,8 +72,8 @@ const std::vector<SettingSpec>& SettingSpecs() {
       {"tls_client_ca", "tls-client-ca", "TOD_TLS_CLIENT_CA",
        "PEM CA certificates: require client certificates it signed (mutual TLS)"},
       {"auth_token_file", "auth-token-file", "TOD_AUTH_TOKEN_FILE",
-       "Bearer tokens, one a line (reloaded on SIGHUP): Detect, DetectStream, GetModelInfo and "
-       "/v1/* need 'authorization: Bearer <token>'"},
+       "Bearer tokens, one a line (reloaded on SIGHUP): Detect, DetectStream, GetModelInfo, "
+       "/v1/*, /v2 and /v2/models/* need 'authorization: Bearer <token>'"},
       {"log_format", "log-format", "TOD_LOG_FORMAT", "text | json (default text)"},
       {"log_level", "log-level", "TOD_LOG_LEVEL", "trace|debug|info|warn|error (default info)"},
   };
@@ -88,6 +91,8 @@ Status ApplySetting(const std::string& key, const std::string& value, const std:
     return ParseNumber(value, what, &config->grpc_port);
   } else if (key == "http_port") {
     return ParseNumber(value, what, &config->http_port);
+  } else if (key == "ports_file") {
+    config->ports_file = value;
   } else if (key == "workers") {
     return ParseNumber(value, what, &config->workers);
   } else if (key == "threads_per_request") {
@@ -303,6 +308,7 @@ nlohmann::json ServerConfigToJson(const ServerConfig& config) {
           {"host", config.host},
           {"grpc_port", config.grpc_port},
           {"http_port", config.http_port},
+          {"ports_file", config.ports_file},
           {"workers", config.workers},
           {"threads_per_request", config.threads_per_request},
           {"frame_budget_ms", config.frame_budget_ms},

@@ -18,6 +18,9 @@ struct ServerConfig {
   std::string host = "0.0.0.0";  // bind address of both listeners
   int grpc_port = 8001;
   int http_port = 8000;
+  // Where to write the bound ports once both listen, as {"grpc":P,"http":P} (written to a
+  // temporary name and renamed); with port 0 the kernel picks free ports and this says which.
+  std::string ports_file;
   int workers = 0;                     // 0: one per core
   int threads_per_request = 1;         // cores one request may use
   double frame_budget_ms = 2000;       // decode to map; 0: no budget

@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <condition_variable>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <mutex>
@@ -284,6 +286,21 @@ void LogListening(const ServerConfig& config, const Security& security, int grpc
             {"auth", security.auth ? "bearer" : "off"}});
 }
 
+// The bound ports for whoever started us (tests, supervisors) when the kernel picked them: written
+// whole to a temporary name, then renamed, so a reader never sees half a file.
+Status WritePortsFile(const std::string& path, int grpc_port, int http_port) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::trunc);
+    out << nlohmann::json{{"grpc", grpc_port}, {"http", http_port}}.dump() << "\n";
+    if (!out.flush()) return Status::Internal("cannot write the ports file " + temporary);
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    return Status::Internal("cannot rename " + temporary + " to " + path);
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 void BlockServerSignals() {
@@ -328,6 +345,13 @@ int RunServer(const ServerConfig& config) {
   }
   http.Start();
   LogListening(config, security, grpc_port, http.port());
+  if (!config.ports_file.empty()) {
+    if (Status written = WritePortsFile(config.ports_file, grpc_port, http.port()); !written.ok()) {
+      http.Stop();
+      grpc_server->Shutdown();
+      return Refuse("cannot write the ports file", written.message(), written.message(), 1);
+    }
+  }
 
   if (Status loaded = models.Load(config.model_dir); !loaded.ok()) {
     http.Stop();

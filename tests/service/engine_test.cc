@@ -202,7 +202,12 @@ TEST_F(EngineTest, StopAnswersQueuedRequestsWithUnavailable) {
   ASSERT_TRUE(detector_->WaitStarted(1));
   engine_->Submit(Request(), queued.callback());
   std::thread stopper([this] { engine_->Stop(); });
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // The gate opens only once Stop() has marked the engine stopping (it is then not ready): had
+  // it opened first, the worker could take the queued request before Stop() began.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (engine_->Ready() && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_FALSE(engine_->Ready());
   detector_->Open();
   stopper.join();
   EXPECT_TRUE(running.get().status.ok());

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -43,7 +44,8 @@ pid_t Spawn(const std::vector<std::string>& argv, const std::string& log_path) {
   posix_spawnattr_setsigmask(&attributes, &none);
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
   pid_t pid = -1;
-  if (posix_spawn(&pid, args[0], &actions, &attributes, args.data(), environ) != 0) pid = -1;
+  // posix_spawnp: a bare name ("curl", "openssl") is looked up on PATH like a shell would.
+  if (posix_spawnp(&pid, args[0], &actions, &attributes, args.data(), environ) != 0) pid = -1;
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
   return pid;
@@ -107,23 +109,45 @@ std::unique_ptr<ServerProcess> ServerProcess::Start(const std::string& model_dir
                                                     HarnessTls tls) {
   std::unique_ptr<ServerProcess> server(new ServerProcess());
   server->tls_ = std::move(tls);
-  server->grpc_port_ = FreeLoopbackPort();
-  do {
-    server->http_port_ = FreeLoopbackPort();
-  } while (server->http_port_ == server->grpc_port_);
-  server->log_path_ = MakeTempDir("tod_server") + "/server.log";
+  // The server binds port 0 and says which ports it got: a port picked here and closed again
+  // could be taken by a parallel test before the server binds it.
+  const std::string dir = MakeTempDir("tod_server");
+  server->log_path_ = dir + "/server.log";
+  const std::string ports_file = dir + "/ports.json";
   std::vector<std::string> argv = {BinaryPath("tod_server"),
                                    "--model",
                                    model_dir,
                                    "--host",
                                    "127.0.0.1",
                                    "--grpc-port",
-                                   std::to_string(server->grpc_port_),
+                                   "0",
                                    "--http-port",
-                                   std::to_string(server->http_port_)};
+                                   "0",
+                                   "--ports-file",
+                                   ports_file};
   argv.insert(argv.end(), extra_args.begin(), extra_args.end());
   server->pid_ = Spawn(argv, server->log_path_);
+  server->ReadPorts(ports_file);
   return server;
+}
+
+void ServerProcess::ReadPorts(const std::string& ports_file) {
+  // Until the file appears (it is renamed into place whole) or the process ends (a refused
+  // configuration: the ports stay 0 and the test reads the exit code and the log).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::ifstream in(ports_file);
+    if (in) {
+      const nlohmann::json ports = nlohmann::json::parse(in, nullptr, false);
+      if (ports.is_object()) {
+        grpc_port_ = ports.value("grpc", 0);
+        http_port_ = ports.value("http", 0);
+        return;
+      }
+    }
+    if (WaitExit(std::chrono::milliseconds(0))) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
 }
 
 ServerProcess::~ServerProcess() {

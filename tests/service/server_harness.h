@@ -46,7 +46,8 @@ ProcessResult RunCommand(const std::vector<std::string>& argv);
 
 class ServerProcess {
  public:
-  // Starts tod_server --model DIR on two free loopback ports plus `extra_args`.
+  // Starts tod_server --model DIR on two free loopback ports plus `extra_args`; returns once the
+  // server listens (its ports are known) or has exited.
   static std::unique_ptr<ServerProcess> Start(const std::string& model_dir,
                                               const std::vector<std::string>& extra_args,
                                               HarnessTls tls = {});
@@ -73,6 +74,8 @@ class ServerProcess {
 
  private:
   ServerProcess() = default;
+  // Waits for tod_server's --ports-file and takes the ports it bound from it.
+  void ReadPorts(const std::string& ports_file);
   pid_t pid_ = -1;
   int grpc_port_ = 0;
   int http_port_ = 0;

@@ -159,10 +159,10 @@ TEST(ServiceCancellationTest, DrainTimeoutIsAHardLimit) {
   REQUIRE_MODEL();
   constexpr double kDrainS = 2;
   auto server = ServerProcess::Start(TestModel(),
-                                     {"--workers", "1", "--queue", "16", "--drain-timeout", "2"});
+                                     {"--workers", "1", "--queue", "256", "--drain-timeout", "2"});
   ASSERT_TRUE(server->WaitReady()) << server->Log();
   auto stub = Stub(*server);
-  const std::string frame = testing::RoadPng(640, 320);
+  const std::string frame = testing::RoadPng(960, 480);
   const auto start = Clock::now();
   for (int i = 0; i < 2; ++i) {
     grpc::ClientContext context;
@@ -171,8 +171,9 @@ TEST(ServiceCancellationTest, DrainTimeoutIsAHardLimit) {
   }
   const double frame_ms =
       std::chrono::duration<double, std::milli>(Clock::now() - start).count() / 2;
-  // Enough frames that the queue cannot drain in time (3 x the timeout of work, or the queue).
-  const int grpc_calls = std::clamp(static_cast<int>(3 * kDrainS * 1000 / frame_ms) + 2, 3, 14);
+  // Enough frames that the queue cannot drain in time: 3 x the timeout of work, however fast the
+  // machine (the queue has room for them all).
+  const int grpc_calls = std::clamp(static_cast<int>(3 * kDrainS * 1000 / frame_ms) + 2, 3, 200);
   std::vector<std::future<grpc::Status>> calls;
   for (int i = 0; i < grpc_calls; ++i) {
     calls.push_back(std::async(std::launch::async, [&] {
