@@ -12,14 +12,14 @@ BUILD_PACKAGES=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libeigen3-dev libspdlog-dev libfmt-dev nlohmann-json3-dev libcli11-dev
   prometheus-cpp-dev libmatio-dev zlib1g-dev libdeflate-dev
-  libboost-dev libjpeg62-turbo-dev libpng-dev libssl-dev
+  libboost-dev libjpeg62-turbo-dev libpng-dev libwebp-dev libssl-dev
   libcpp-httplib-dev
   libgtest-dev libgmock-dev
   clang libclang-rt-14-dev
   openssl stress-ng curl
 )
 # libboost-dev: Boost.Beast/Asio (header-only) for tod_server's REST transport.
-# libjpeg62-turbo-dev, libpng-dev: tod_server's strict image decoders.
+# libjpeg62-turbo-dev, libpng-dev, libwebp-dev: tod_server's strict image decoders.
 # libssl-dev: TLS of tod_server's REST transport (Boost.Asio's ssl::stream) and token digests.
 # libdeflate-dev: whole-buffer inflate of the plain-PNG decoder (core/data/plain_png.cc), twice
 # zlib's speed on a frame's image data.
@@ -38,7 +38,7 @@ RUNTIME_PACKAGES=(
   libopencv-contrib406
   libgrpc++1.51 libgrpc29 libprotobuf32
   libspdlog1.10 libfmt9 libprometheus-cpp-core1.0 libmatio11
-  libjpeg62-turbo libpng16-16 libdeflate0 libssl3
+  libjpeg62-turbo libpng16-16 libwebp7 libdeflate0 libssl3
   libcpp-httplib0.11
 )
 # libcpp-httplib0.11: tod_load's HTTP client; tod_server does not load it.

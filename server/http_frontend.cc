@@ -11,6 +11,7 @@
 #include "server/http/http_server.h"
 #include "server/http/query_string.h"
 #include "server/logging.h"
+#include "server/oip/oip_rest.h"
 #include "server/rest_options.h"
 #include "server/status_mapping.h"
 
@@ -47,10 +48,10 @@ std::optional<Outcome> ParseRequest(const http::IncomingRequest& request,
                                     InferenceRequest* inference, std::string* frame_id) {
   const std::string_view content_type = request.message[field::content_type];
   const std::string media_type = MediaType(content_type);
-  if (media_type != "image/jpeg" && media_type != "image/png") {
-    const std::string message =
-        "Content-Type '" + std::string(content_type) +
-        "' is not supported; send the raw image with Content-Type image/jpeg or image/png";
+  if (media_type != "image/jpeg" && media_type != "image/png" && media_type != "image/webp") {
+    const std::string message = "Content-Type '" + std::string(content_type) +
+                                "' is not supported; send the raw image with Content-Type "
+                                "image/jpeg, image/png or image/webp";
     return Outcome{http::JsonErrorResponse(415, "INVALID_ARGUMENT", message), "INVALID_ARGUMENT",
                    message};
   }
@@ -91,7 +92,13 @@ class RestApi {
  public:
   RestApi(const HttpFrontendConfig& config, InferenceEngine& engine, const ModelHolder& models,
           ServerMetrics& metrics, std::atomic<uint64_t>& counter)
-      : config_(config), engine_(engine), models_(models), metrics_(metrics), counter_(counter) {}
+      : config_(config),
+        engine_(engine),
+        models_(models),
+        metrics_(metrics),
+        counter_(counter),
+        oip_(config.retry_after_s, config.limits.max_body_bytes, engine, models, metrics, counter) {
+  }
 
   http::Router Routes() const {
     http::Router router;
@@ -115,6 +122,7 @@ class RestApi {
     router.Add(verb::get, "/metrics", [this](http::IncomingRequest, http::Responder r) {
       r(http::ContentResponse(metrics_.SerializeText(), "text/plain; version=0.0.4"));
     });
+    oip_.AddRoutes(&router);  // the Open Inference Protocol: /v2, /v2/models/...
     return router;
   }
 
@@ -189,6 +197,7 @@ class RestApi {
   const ModelHolder& models_;
   ServerMetrics& metrics_;
   std::atomic<uint64_t>& counter_;
+  const oip::OipRestApi oip_;
 };
 
 HttpFrontend::HttpFrontend(HttpFrontendConfig config, InferenceEngine& engine,
@@ -217,8 +226,9 @@ HttpFrontend::HttpFrontend(HttpFrontendConfig config, InferenceEngine& engine,
   options.tls = config_.tls;
   if (config_.auth) {
     options.authorizer = [auth = config_.auth](const http::Request& header) {
-      // Probes (/v2/health/*) and scrapers (/metrics) stay open; the API needs a token.
-      if (http::TargetPath(header.target()).rfind("/v1/", 0) != 0) {
+      // Probes (/v2/health/*) and scrapers (/metrics) stay open; both APIs need a token.
+      const std::string_view path = http::TargetPath(header.target());
+      if (!path.starts_with("/v1/") && !oip::NeedsToken(path)) {
         return std::optional<std::string>();
       }
       return auth->Check(header[field::authorization]);

@@ -2,11 +2,12 @@
 // requests go through the same engine (queue, workers, limits) as gRPC; the JSON is the proto3
 // JSON form of the same tod.v1 messages.
 //
-//   POST /v1/detect             body: JPEG/PNG; query: max_proposals, obstacle_threshold,
+//   POST /v1/detect             body: JPEG/PNG/WebP; query: max_proposals, obstacle_threshold,
 //                               map=png|none, frame_id, timeout_ms  -> DetectResponse JSON
 //   POST /v1/probability-map    same input                          -> image/png map
 //   GET  /v1/model                                                   -> ModelInfo JSON
 //   GET  /v2/health/live, /v2/health/ready, /metrics
+//   /v2, /v2/models/...         the Open Inference Protocol (KServe v2), server/oip/oip_rest.h
 //
 // No handler blocks an I/O thread: detection answers from the engine's completion. A client that
 // disconnects while its detection runs cancels it (the transport's client_gone).
@@ -38,8 +39,8 @@ struct HttpFrontendConfig {
   int retry_after_s = 1;
   int io_threads = 2;
   std::shared_ptr<boost::asio::ssl::context> tls;  // HTTPS when set
-  // When set, /v1/* need a bearer token (checked from the header, before the body is read);
-  // /v2/health/* and /metrics stay open for probes and scrapers.
+  // When set, /v1/*, /v2 and /v2/models/* need a bearer token (checked from the header, before
+  // the body is read); /v2/health/* and /metrics stay open for probes and scrapers.
   std::shared_ptr<const TokenAuthenticator> auth;
 };
 

@@ -9,7 +9,9 @@
 namespace tod::server {
 
 Result<cv::Mat3b> DecodeImage(std::string_view bytes, const ImageLimits& limits) {
-  if (bytes.empty()) return Status::InvalidArgument("image: empty body, expected a JPEG or PNG");
+  if (bytes.empty()) {
+    return Status::InvalidArgument("image: empty body, expected a JPEG, PNG or WebP");
+  }
   if (bytes.size() > limits.max_bytes) {
     return Status::ResourceExhausted("image: " + std::to_string(bytes.size()) +
                                      " bytes is over the limit of " +
@@ -26,8 +28,15 @@ Result<cv::Mat3b> DecodeImage(std::string_view bytes, const ImageLimits& limits)
   }
   // The decoders check their own header against the pixel limit again before allocating, so
   // nothing this function accepted can decode to more pixels than the limit allows.
-  return header->format == ImageFormat::kJpeg ? DecodeJpegStrict(bytes, limits.max_pixels)
-                                              : DecodePngStrict(bytes, limits.max_pixels);
+  switch (header->format) {
+    case ImageFormat::kJpeg:
+      return DecodeJpegStrict(bytes, limits.max_pixels);
+    case ImageFormat::kWebp:
+      return DecodeWebpStrict(bytes, limits.max_pixels);
+    case ImageFormat::kPng:
+      break;
+  }
+  return DecodePngStrict(bytes, limits.max_pixels);
 }
 
 Result<std::string> EncodeProbabilityPng(const cv::Mat1f& probability) {

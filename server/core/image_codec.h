@@ -16,7 +16,7 @@ struct ImageLimits {
   long long max_pixels = 4'000'000;  // width * height from the header
 };
 
-// Decodes a JPEG/PNG to 8-bit BGR. Empty, unrecognised, corrupt or truncated input (decoder
+// Decodes a JPEG/PNG/WebP to 8-bit BGR. Empty, unrecognised, corrupt or truncated input (decoder
 // warnings included) is InvalidArgument; input over a limit is ResourceExhausted, decided from
 // the header before pixel memory is allocated. Messages say which limit and by how much.
 Result<cv::Mat3b> DecodeImage(std::string_view bytes, const ImageLimits& limits);

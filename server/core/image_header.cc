@@ -1,5 +1,7 @@
 #include "server/core/image_header.h"
 
+#include <webp/decode.h>
+
 #include <array>
 #include <cstdint>
 #include <string>
@@ -82,16 +84,33 @@ Result<ImageHeader> PeekJpeg(std::string_view b) {
   return Status::InvalidArgument("image: JPEG has no frame header (truncated or corrupt)");
 }
 
+// "RIFF" <size> "WEBP": a WebP file (the first chunk then says lossy, lossless or extended).
+bool StartsWithWebpSignature(std::string_view b) {
+  return b.size() >= 12 && b.substr(0, 4) == "RIFF" && b.substr(8, 4) == "WEBP";
+}
+
+Result<ImageHeader> PeekWebp(std::string_view b) {
+  int width = 0, height = 0;
+  if (!WebPGetInfo(reinterpret_cast<const uint8_t*>(b.data()), b.size(), &width, &height) ||
+      width <= 0 || height <= 0) {
+    return Status::InvalidArgument("image: WebP header is truncated or invalid");
+  }
+  return ImageHeader{ImageFormat::kWebp, cv::Size(width, height)};
+}
+
 }  // namespace
 
 Result<ImageHeader> PeekImageHeader(std::string_view bytes) {
-  if (bytes.empty()) return Status::InvalidArgument("image: empty body, expected a JPEG or PNG");
+  if (bytes.empty()) {
+    return Status::InvalidArgument("image: empty body, expected a JPEG, PNG or WebP");
+  }
   if (StartsWithPngSignature(bytes)) return PeekPng(bytes);
+  if (StartsWithWebpSignature(bytes)) return PeekWebp(bytes);
   if (bytes.size() >= 3 && static_cast<uint8_t>(bytes[0]) == 0xFF &&
       static_cast<uint8_t>(bytes[1]) == 0xD8 && static_cast<uint8_t>(bytes[2]) == 0xFF) {
     return PeekJpeg(bytes);
   }
-  return Status::InvalidArgument("image: not a JPEG or PNG (unrecognised signature, " +
+  return Status::InvalidArgument("image: not a JPEG, PNG or WebP (unrecognised signature, " +
                                  std::to_string(bytes.size()) + " bytes)");
 }
 

@@ -9,14 +9,15 @@
 
 namespace tod::server {
 
-enum class ImageFormat { kPng, kJpeg };
+enum class ImageFormat { kPng, kJpeg, kWebp };
 
 struct ImageHeader {
   ImageFormat format = ImageFormat::kPng;
   cv::Size size;
 };
 
-// PNG (IHDR) and baseline/progressive JPEG (first SOFn marker). Anything else, or a truncated
+// PNG (IHDR), baseline/progressive JPEG (first SOFn marker) and WebP (its RIFF container's first
+// chunk, read by libwebp's header parser, which allocates nothing). Anything else, or a truncated
 // header, is InvalidArgument with a message saying what was wrong.
 Result<ImageHeader> PeekImageHeader(std::string_view bytes);
 

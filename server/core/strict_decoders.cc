@@ -5,6 +5,7 @@
 #include <jpeglib.h>
 // clang-format on
 #include <png.h>
+#include <webp/decode.h>
 
 #include <algorithm>
 #include <csetjmp>
@@ -176,6 +177,35 @@ struct PngStateDeleter {
   }
 };
 
+// libwebp's status codes as the words a client can act on.
+const char* WebpStatusName(VP8StatusCode status) {
+  switch (status) {
+    case VP8_STATUS_OK:
+      return "ok";
+    case VP8_STATUS_OUT_OF_MEMORY:
+      return "out of memory";
+    case VP8_STATUS_INVALID_PARAM:
+      return "invalid parameter";
+    case VP8_STATUS_BITSTREAM_ERROR:
+      return "bitstream error";
+    case VP8_STATUS_UNSUPPORTED_FEATURE:
+      return "unsupported feature";
+    case VP8_STATUS_SUSPENDED:
+      return "suspended";
+    case VP8_STATUS_USER_ABORT:
+      return "aborted";
+    case VP8_STATUS_NOT_ENOUGH_DATA:
+      return "not enough data (truncated)";
+  }
+  return "unknown error";
+}
+
+// Frees what libwebp allocated for the decoder's output (nothing when the output is ours).
+struct WebpOutputRelease {
+  WebPDecBuffer* buffer;
+  ~WebpOutputRelease() { WebPFreeDecBuffer(buffer); }
+};
+
 Status Corrupt(const char* format, const char* message) {
   return Status::InvalidArgument(std::string("image: cannot decode ") + format +
                                  " (corrupt or truncated): " + message);
@@ -237,6 +267,39 @@ Result<cv::Mat3b> DecodePngStrict(std::string_view bytes, long long max_pixels) 
   std::vector<png_bytep> rows(static_cast<size_t>(image.rows));
   for (int y = 0; y < image.rows; ++y) rows[static_cast<size_t>(y)] = image.ptr<uchar>(y);
   if (!PngReadPixels(state.get(), rows.data())) return Corrupt("PNG", state->message);
+  return image;
+}
+
+Result<cv::Mat3b> DecodeWebpStrict(std::string_view bytes, long long max_pixels) {
+  const auto* data = reinterpret_cast<const uint8_t*>(bytes.data());
+  WebPDecoderConfig config;
+  if (!WebPInitDecoderConfig(&config)) return Status::Internal("image: libwebp version mismatch");
+  // The header alone: size, alpha and animation, read before any pixel memory exists.
+  if (const VP8StatusCode status = WebPGetFeatures(data, bytes.size(), &config.input);
+      status != VP8_STATUS_OK) {
+    return Corrupt("WebP", WebpStatusName(status));
+  }
+  const WebPBitstreamFeatures& features = config.input;
+  if (features.has_animation) {
+    return Status::InvalidArgument("image: animated WebP is not supported; send one frame");
+  }
+  if (features.width <= 0 || features.height <= 0) return Corrupt("WebP", "invalid size");
+  const auto width = static_cast<unsigned long>(features.width);
+  const auto height = static_cast<unsigned long>(features.height);
+  if (OverLimit(width, height, max_pixels))
+    return OverPixelLimit("WebP", width, height, max_pixels);
+  // Decoded straight into our frame, in OpenCV's BGR order; alpha, if any, is dropped.
+  cv::Mat3b image(features.height, features.width);
+  config.output.colorspace = MODE_BGR;
+  config.output.is_external_memory = 1;
+  config.output.u.RGBA.rgba = image.data;
+  config.output.u.RGBA.stride = static_cast<int>(image.step);
+  config.output.u.RGBA.size = image.step * static_cast<size_t>(image.rows);
+  const WebpOutputRelease release{&config.output};
+  if (const VP8StatusCode status = WebPDecode(data, bytes.size(), &config);
+      status != VP8_STATUS_OK) {
+    return Corrupt("WebP", WebpStatusName(status));
+  }
   return image;
 }
 

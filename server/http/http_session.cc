@@ -294,15 +294,17 @@ void HttpSession<Stream>::Dispatch() {
     OnHandlerResponse(JsonErrorResponse(500, "INTERNAL", "the request could not be handled"));
   }
   // Answers arrive through a post to this strand, never inline: the handler is still at work.
-  if (awaiting_handler_) Watch();
+  // Bytes of a next request already buffered (a pipelining client) say the client is there, and
+  // a watch read then must not start: after the answer it would be the only read pending, and
+  // the buffered request would wait for bytes that never come (HTTP/1.1 answers in order: the
+  // client waits for ours first). Without a watch, OnWritten starts the buffered request.
+  if (awaiting_handler_ && buffer_.size() == 0) Watch();
 }
 
 template <class Stream>
 void HttpSession<Stream>::Watch() {
-  const size_t room = buffer_.max_size() - buffer_.size();
-  if (room == 0) return;  // a pipelining client filled the buffer: it is there, no need to watch
   watching_ = true;
-  stream_.async_read_some(buffer_.prepare(std::min(room, kReadChunk)),
+  stream_.async_read_some(buffer_.prepare(kReadChunk),
                           [self = this->shared_from_this()](beast::error_code ec, size_t bytes) {
                             self->OnWatch(ec, bytes);
                           });

@@ -1,5 +1,5 @@
 // Fuzzes what the service does with the bytes of an uploaded image: the header sniffer that
-// admission uses (PeekImageHeader) and the strict JPEG/PNG decoders behind DecodeImage.
+// admission uses (PeekImageHeader) and the strict JPEG/PNG/WebP decoders behind DecodeImage.
 // Invariants checked besides memory safety: a decoded image is never larger than the pixel limit,
 // never larger than its own header said, and decoding is refused exactly when it should be.
 #include <cstddef>
@@ -52,7 +52,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
   // The decoders are also called directly (DecodeImage only reaches the one the header names),
   // so a PNG decoder is fuzzed with JPEG bytes and the other way round.
-  for (const auto decode : {&tod::server::DecodeJpegStrict, &tod::server::DecodePngStrict}) {
+  for (const auto decode : {&tod::server::DecodeJpegStrict, &tod::server::DecodePngStrict,
+                            &tod::server::DecodeWebpStrict}) {
     const tod::Result<cv::Mat3b> direct = decode(bytes, kMaxPixels);
     if (direct.ok()) Check(!direct->empty() && direct->total() <= static_cast<size_t>(kMaxPixels));
   }

@@ -101,6 +101,13 @@ void ImageSeeds() {
   Write("fuzz_image_decode", "grey.jpg", Encode(".jpg", grey, {cv::IMWRITE_JPEG_QUALITY, 80}));
   Write("fuzz_image_decode", "progressive.jpg",
         Encode(".jpg", frame, {cv::IMWRITE_JPEG_PROGRESSIVE, 1, cv::IMWRITE_JPEG_QUALITY, 70}));
+  cv::Mat alpha;
+  cv::cvtColor(frame, alpha, cv::COLOR_BGR2BGRA);
+  for (const std::string target : {"fuzz_image_decode", "fuzz_webp_decode"}) {
+    Write(target, "lossy.webp", Encode(".webp", frame, {cv::IMWRITE_WEBP_QUALITY, 60}));
+    Write(target, "lossless.webp", Encode(".webp", frame, {cv::IMWRITE_WEBP_QUALITY, 101}));
+    Write(target, "alpha.webp", Encode(".webp", alpha, {cv::IMWRITE_WEBP_QUALITY, 101}));
+  }
 }
 
 void RestSeeds() {

@@ -35,7 +35,7 @@ TEST(ImageHeaderTest, RejectsEmptyUnknownAndTruncated) {
   EXPECT_EQ(PeekImageHeader("").status().code(), StatusCode::kInvalidArgument);
   const Status garbage = PeekImageHeader("GIF89a....").status();
   EXPECT_EQ(garbage.code(), StatusCode::kInvalidArgument);
-  EXPECT_NE(garbage.message().find("not a JPEG or PNG"), std::string::npos);
+  EXPECT_NE(garbage.message().find("not a JPEG, PNG or WebP"), std::string::npos);
   const std::string png = testing::RoadPng();
   EXPECT_FALSE(PeekImageHeader(png.substr(0, 20)).ok());
   const std::string jpeg = testing::Encode(testing::RoadFrame(), ".jpg");
@@ -150,6 +150,84 @@ TEST(ImageCodecTest, ProbabilityPngIsScaledAndClamped) {
   EXPECT_EQ(map.at<uchar>(1, 1), 255);
   EXPECT_EQ(map.at<uchar>(1, 2), 26);
   EXPECT_FALSE(EncodeProbabilityPng(cv::Mat1f()).ok());
+}
+
+// ---- WebP ------------------------------------------------------------------------------------
+
+std::string Webp(const cv::Mat& frame, int quality) {
+  std::vector<uchar> bytes;
+  EXPECT_TRUE(cv::imencode(".webp", frame, bytes, {cv::IMWRITE_WEBP_QUALITY, quality}));
+  return std::string(bytes.begin(), bytes.end());
+}
+
+// A hand-written extended-format header: RIFF, "VP8X" with the given flags and canvas size,
+// and nothing after it.
+std::string Vp8xHeader(uint8_t flags, int width, int height) {
+  std::string b = "RIFF";
+  b += std::string("\x16\0\0\0", 4);  // RIFF size: "WEBP" + the 18-byte VP8X chunk
+  b += "WEBPVP8X";
+  b += std::string("\x0a\0\0\0", 4);
+  b += static_cast<char>(flags);
+  b += std::string(3, '\0');
+  for (int side : {width - 1, height - 1})
+    for (int k = 0; k < 3; ++k) b += static_cast<char>((side >> (8 * k)) & 0xFF);
+  return b;
+}
+
+TEST(ImageHeaderTest, ReadsWebpSizesWithoutDecoding) {
+  const cv::Mat3b frame = testing::RoadFrame(321, 123);
+  for (const int quality : {80, 101}) {  // lossy (VP8) and lossless (VP8L, quality > 100)
+    const Result<ImageHeader> webp = PeekImageHeader(Webp(frame, quality));
+    ASSERT_TRUE(webp.ok()) << webp.status().message();
+    EXPECT_EQ(webp->format, ImageFormat::kWebp);
+    EXPECT_EQ(webp->size, cv::Size(321, 123)) << quality;
+  }
+  const Result<ImageHeader> extended = PeekImageHeader(Vp8xHeader(0, 5000, 4000));
+  ASSERT_TRUE(extended.ok()) << extended.status().message();
+  EXPECT_EQ(extended->size, cv::Size(5000, 4000));
+  EXPECT_FALSE(PeekImageHeader(Webp(frame, 80).substr(0, 16)).ok());
+}
+
+TEST(StrictDecoderTest, DecodesWebpLikeOpenCv) {
+  const cv::Mat3b frame = Textured(97, 41);
+  for (const int quality : {80, 101}) {
+    const std::string bytes = Webp(frame, quality);
+    const Result<cv::Mat3b> ours = DecodeImage(bytes, ImageLimits{});
+    ASSERT_TRUE(ours.ok()) << quality << ": " << ours.status().message();
+    const cv::Mat reference =
+        cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_COLOR);
+    EXPECT_EQ(cv::norm(*ours, reference, cv::NORM_INF), 0) << quality;
+  }
+  // Lossless is lossless; alpha is dropped.
+  const Result<cv::Mat3b> lossless = DecodeImage(Webp(frame, 101), ImageLimits{});
+  ASSERT_TRUE(lossless.ok());
+  EXPECT_EQ(cv::norm(*lossless, frame, cv::NORM_INF), 0);
+  cv::Mat alpha;
+  cv::cvtColor(frame, alpha, cv::COLOR_BGR2BGRA);
+  const Result<cv::Mat3b> from_alpha = DecodeImage(Webp(alpha, 101), ImageLimits{});
+  ASSERT_TRUE(from_alpha.ok()) << from_alpha.status().message();
+  EXPECT_EQ(cv::norm(*from_alpha, frame, cv::NORM_INF), 0);
+}
+
+TEST(StrictDecoderTest, TruncatedAnimatedOrHugeWebpIsRefused) {
+  for (const int quality : {80, 101}) {
+    const std::string webp = Webp(Textured(160, 96), quality);
+    for (const std::string& bad :
+         {webp.substr(0, webp.size() / 2), webp.substr(0, webp.size() - 1), webp.substr(0, 30)}) {
+      const Status status = DecodeImage(bad, ImageLimits{}).status();
+      EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << quality << ": " << status.message();
+      EXPECT_NE(status.message().find("WebP"), std::string::npos) << status.message();
+    }
+  }
+  const Status animated = DecodeWebpStrict(Vp8xHeader(0x02, 64, 32), 1 << 20).status();
+  EXPECT_EQ(animated.code(), StatusCode::kInvalidArgument) << animated.message();
+  // The pixel limit holds on the header, before any pixel memory: a 5000 x 4000 canvas in 30 bytes.
+  const Status huge = DecodeImage(Vp8xHeader(0, 5000, 4000), ImageLimits{}).status();
+  EXPECT_EQ(huge.code(), StatusCode::kResourceExhausted) << huge.message();
+  EXPECT_NE(huge.message().find("5000x4000"), std::string::npos) << huge.message();
+  const std::string small = Webp(Textured(64, 32), 80);
+  EXPECT_EQ(DecodeWebpStrict(small, 64 * 32 - 1).status().code(), StatusCode::kResourceExhausted);
+  EXPECT_TRUE(DecodeWebpStrict(small, 64 * 32).ok());
 }
 
 }  // namespace

@@ -279,6 +279,79 @@ TEST_F(HttpHardeningTest, TruncatedOrZeroedImagesAreInvalid) {
   }
 }
 
+// Probe: two requests sent back to back on one connection: the first was answered, the second
+// never (it waited in the buffer while the server waited for more bytes, until the idle timeout).
+TEST_F(HttpHardeningTest, PipelinedRequestsAreAnsweredInOrder) {
+  const std::string png = testing::Encode(NoisyFrame(), ".png");
+  const std::string detect =
+      "POST /v1/detect?map=none&frame_id=second HTTP/1.1\r\nHost: t\r\nContent-Type: image/png\r\n"
+      "Content-Length: " +
+      std::to_string(png.size()) + "\r\n\r\n" + png;
+  RawConnection connection(port());
+  ASSERT_TRUE(connection.connected());
+  ASSERT_TRUE(connection.Send("GET /v2/health/live HTTP/1.1\r\nHost: t\r\n\r\n" + detect +
+                              "GET /v1/model HTTP/1.1\r\nHost: t\r\n\r\n"));
+  const auto live = connection.ReadResponse(60s);
+  ASSERT_TRUE(live) << "the first of three pipelined requests was not answered";
+  EXPECT_EQ(live->status, 200);
+  EXPECT_NE(live->body.find("live"), std::string::npos) << live->body;
+  const auto detected = connection.ReadResponse(60s);
+  ASSERT_TRUE(detected) << "the second of three pipelined requests was not answered";
+  ASSERT_EQ(detected->status, 200) << detected->body;
+  EXPECT_EQ(nlohmann::json::parse(detected->body)["frame_id"], "second");
+  const auto model = connection.ReadResponse(60s);
+  ASSERT_TRUE(model) << "the third of three pipelined requests was not answered";
+  EXPECT_EQ(model->status, 200) << model->body;
+  EXPECT_TRUE(nlohmann::json::parse(model->body).contains("version")) << model->body;
+
+  // A first request that asks to close: answered, then the connection ends (not left hanging).
+  RawConnection closing(port());
+  ASSERT_TRUE(closing.connected());
+  ASSERT_TRUE(
+      closing.Send("GET /v2/health/live HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n"
+                   "GET /v2/health/live HTTP/1.1\r\nHost: t\r\n\r\n"));
+  const auto first = closing.ReadResponse(60s);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->status, 200);
+  EXPECT_TRUE(closing.WaitClosed(30s));
+}
+
+// WebP frames (what the obstacle benchmarks ship) are served like PNG and JPEG on REST and gRPC:
+// a lossless WebP gives the detections of the PNG of the same pixels; a truncated one is 400 /
+// INVALID_ARGUMENT.
+TEST_F(HttpHardeningTest, WebpFramesAreServedAndBrokenOnesRefused) {
+  const cv::Mat3b frame = NoisyFrame();
+  std::vector<uchar> encoded;
+  ASSERT_TRUE(cv::imencode(".webp", frame, encoded, {cv::IMWRITE_WEBP_QUALITY, 101}));
+  const std::string webp(encoded.begin(), encoded.end());
+  const auto from_png =
+      http_->Post("/v1/detect?map=none", testing::Encode(frame, ".png"), "image/png");
+  const auto from_webp = http_->Post("/v1/detect?map=none", webp, "image/webp");
+  ASSERT_TRUE(from_png && from_webp);
+  ASSERT_EQ(from_webp->status, 200) << from_webp->body;
+  nlohmann::json png_json = nlohmann::json::parse(from_png->body);
+  nlohmann::json webp_json = nlohmann::json::parse(from_webp->body);
+  ASSERT_FALSE(webp_json["proposals"].empty()) << from_webp->body;
+  EXPECT_EQ(webp_json["proposals"], png_json["proposals"]);
+  EXPECT_EQ(webp_json["obstacles"], png_json["obstacles"]);
+
+  client::TodGrpcClient grpc(server_->grpc_address());
+  tod::v1::DetectRequest request;
+  request.set_image(webp);
+  tod::v1::DetectResponse response;
+  const grpc::Status ok = grpc.Detect(request, &response);
+  ASSERT_TRUE(ok.ok()) << ok.error_message();
+  EXPECT_EQ(static_cast<size_t>(response.proposals_size()), webp_json["proposals"].size());
+
+  const std::string truncated = webp.substr(0, webp.size() / 2);
+  const auto rest = http_->Post("/v1/detect?map=none", truncated, "image/webp");
+  ASSERT_TRUE(rest);
+  EXPECT_EQ(rest->status, 400) << rest->body;
+  EXPECT_NE(ErrorMessage(rest->body).find("WebP"), std::string::npos) << rest->body;
+  request.set_image(truncated);
+  EXPECT_EQ(grpc.Detect(request, &response).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+}
+
 // Probe: timeout_ms=9223372036854775807 used to overflow into an immediate 504.
 TEST_F(HttpHardeningTest, NumericOptionsAreRangeCheckedWithoutOverflow) {
   const std::string png = testing::RoadPng();

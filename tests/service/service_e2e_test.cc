@@ -363,7 +363,7 @@ TEST_F(ServiceE2ETest, RestErrorsHaveCodesAndMessages) {
   const std::string png = testing::RoadPng();
   const std::vector<Case> cases = {
       {"/v1/detect", "", "image/png", 400, "empty"},
-      {"/v1/detect", "this is not an image", "image/jpeg", 400, "not a JPEG or PNG"},
+      {"/v1/detect", "this is not an image", "image/jpeg", 400, "not a JPEG, PNG or WebP"},
       {"/v1/detect", png.substr(0, png.size() / 2), "image/png", 400, "decode"},
       {"/v1/detect", png, "text/plain", 415, "Content-Type"},
       {"/v1/detect", std::string(kMaxBytes + 10, 'x'), "image/png", 413, "bytes"},
