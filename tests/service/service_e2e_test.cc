@@ -145,6 +145,54 @@ TEST_F(ServiceE2ETest, GrpcAndRestAgreeOnASyntheticFrame) {
   EXPECT_LE(no_map_json["proposals"].size(), 2u);
 }
 
+// Parity: one frame through `tod detect`, gRPC and REST gives the same non-empty proposals, the
+// same obstacles and the same map (the server and the tool share the detector, not a copy of it).
+TEST_F(ServiceE2ETest, TheToolGrpcAndRestGiveTheSameDetections) {
+  const std::string frame = testing::RoadPng();
+  const std::string dir = testing::MakeTempDir("tod_parity");
+  std::ofstream(dir + "/frame.png", std::ios::binary) << frame;
+  const auto tool = RunCommand({testing::BinaryPath("tod"), "detect", "--model", TestModel(),
+                                "--out", dir + "/out", dir + "/frame.png"});
+  ASSERT_EQ(tool.exit_code, 0) << tool.output;
+  std::ifstream tool_json_file(dir + "/out/frame.json");
+  const nlohmann::json tool_json = nlohmann::json::parse(tool_json_file);
+  const cv::Mat tool_map = cv::imread(dir + "/out/frame_prob.png", cv::IMREAD_UNCHANGED);
+
+  tod::v1::DetectResponse grpc_response;
+  const grpc::Status status = grpc_->Detect(MakeRequest(frame), &grpc_response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  const auto rest = PostImage(*http_, "/v1/detect", frame);
+  ASSERT_TRUE(rest);
+  ASSERT_EQ(rest->status, 200) << rest->body;
+  const nlohmann::json rest_json = nlohmann::json::parse(rest->body);
+
+  ASSERT_GT(grpc_response.proposals_size(), 0) << "nothing to compare";
+  ASSERT_GE(tool_json["proposals"].size(), static_cast<size_t>(grpc_response.proposals_size()));
+  ASSERT_EQ(rest_json["proposals"].size(), static_cast<size_t>(grpc_response.proposals_size()));
+  for (int i = 0; i < grpc_response.proposals_size(); ++i) {
+    const tod::v1::Proposal& served = grpc_response.proposals(i);
+    const nlohmann::json& listed = tool_json["proposals"][i];
+    EXPECT_EQ(listed["x"], served.box().x()) << i;
+    EXPECT_EQ(listed["y"], served.box().y()) << i;
+    EXPECT_EQ(listed["w"], served.box().w()) << i;
+    EXPECT_EQ(listed["h"], served.box().h()) << i;
+    EXPECT_FLOAT_EQ(listed["score"].get<float>(), served.fused()) << i;
+    EXPECT_EQ(rest_json["proposals"][i]["box"]["x"], served.box().x()) << i;
+    EXPECT_FLOAT_EQ(rest_json["proposals"][i]["fused"].get<float>(), served.fused()) << i;
+  }
+  EXPECT_EQ(tool_json["obstacles"].size(), static_cast<size_t>(grpc_response.obstacles_size()));
+  EXPECT_EQ(rest_json["obstacles"].size(), static_cast<size_t>(grpc_response.obstacles_size()));
+
+  const std::string& png = grpc_response.probability_map().png();
+  const cv::Mat served_map =
+      cv::imdecode(std::vector<uchar>(png.begin(), png.end()), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(tool_map.empty());
+  ASSERT_EQ(served_map.size(), tool_map.size());
+  EXPECT_GT(cv::countNonZero(tool_map), 0) << "an empty map proves nothing";
+  EXPECT_EQ(cv::norm(served_map, tool_map, cv::NORM_INF), 0) << "the maps differ";
+  fs::remove_all(dir);
+}
+
 TEST_F(ServiceE2ETest, StreamAnswersEveryFrameInOrder) {
   std::vector<tod::v1::DetectRequest> requests;
   for (int i = 0; i < 4; ++i) {

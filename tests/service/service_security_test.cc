@@ -89,6 +89,14 @@ TEST_F(ServiceSecurityTest, TlsAndTokensOnGrpcAndHttpsWithProbesOpen) {
   ASSERT_TRUE(with_token.GetModelInfo(&info).ok());
   EXPECT_EQ(info.model_dir(), info.name());
   EXPECT_EQ(info.model_dir().find('/'), std::string::npos) << info.model_dir();
+  // DetectStream over TLS with the token: one answer per frame, in order.
+  std::vector<tod::v1::DetectRequest> frames(3, SmallRequest());
+  for (size_t i = 0; i < frames.size(); ++i) frames[i].set_frame_id("tls-" + std::to_string(i));
+  std::vector<std::string> streamed;
+  status = with_token.DetectStream(
+      frames, [&](const tod::v1::DetectResponse& r) { streamed.push_back(r.frame_id()); });
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(streamed, (std::vector<std::string>{"tls-0", "tls-1", "tls-2"}));
   for (const std::string& token : {std::string(), std::string(kOtherToken)}) {
     client::TodGrpcClient refused(server->grpc_address(), Connection(pki_, token));
     status = refused.Detect(SmallRequest(), &response);
