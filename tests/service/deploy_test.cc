@@ -1,7 +1,9 @@
 // What can be checked of the deployment without a Docker engine or a cluster: the Kustomize
-// manifests' structure, the Dockerfile's contract, and that the runtime package list covers every
-// shared library tod_server loads.
+// manifests' structure, the KServe InferenceService (its arguments start a real server), the
+// Dockerfile's contract, and that the runtime package list covers every shared library
+// tod_server loads.
 #include <gtest/gtest.h>
+#include <httplib.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +16,7 @@
 #include <sstream>
 
 #include "tests/service/mini_yaml.h"
+#include "tests/service/server_harness.h"
 #include "tests/test_env.h"
 
 namespace tod::server {
@@ -251,6 +254,52 @@ TEST(DeployTest, DeploymentMountsTlsAndTokensFromSecrets) {
     EXPECT_EQ(container.Str(prefix + "scheme"), "HTTPS") << probe;
     EXPECT_EQ(container.Str(prefix + "path").rfind("/v2/health/", 0), 0u) << probe;
   }
+}
+
+// KServe sends a custom predictor's traffic to kserve-container on port 8080 and probes it; the
+// REST listener must be there, the probes on the open v2 health paths, the model the image's.
+// The container's arguments must also start the server: they run here, with the test model and
+// free ports in place of the image's model and the fixed ports.
+TEST(DeployTest, KserveInferenceServiceRunsTheServerAsAV2Predictor) {
+  const auto docs =
+      ParseYamlDocuments(ReadText(SourceDir() + "/deploy/k8s/kserve/inferenceservice.yaml"));
+  ASSERT_TRUE(docs.ok()) << docs.status().message();
+  const YamlNode& service = (*docs)[0];
+  EXPECT_EQ(service.Str("apiVersion"), "serving.kserve.io/v1beta1");
+  EXPECT_EQ(service.Str("kind"), "InferenceService");
+  const YamlNode* containers = service.Path("spec.predictor.containers");
+  ASSERT_NE(containers, nullptr);
+  ASSERT_EQ(containers->items.size(), 1u);
+  const YamlNode& container = containers->items[0];
+  EXPECT_EQ(container.Str("name"), "kserve-container");
+  ASSERT_EQ(container.Get("ports")->items.size(), 1u);
+  EXPECT_EQ(container.Get("ports")->items[0].Str("containerPort"), "8080");
+  for (const char* probe : {"readinessProbe", "livenessProbe"}) {
+    const std::string prefix = std::string(probe) + ".httpGet.";
+    EXPECT_EQ(container.Str(prefix + "port"), "8080") << probe;
+    EXPECT_EQ(container.Str(prefix + "path").rfind("/v2/health/", 0), 0u) << probe;
+  }
+  std::map<std::string, std::string> flags;
+  std::vector<std::string> other_args;
+  for (const YamlNode& arg : container.Get("args")->items) {
+    const size_t equals = arg.scalar.find('=');
+    const std::string name = arg.scalar.substr(0, equals);
+    if (name == "--model" || name == "--http-port" || name == "--grpc-port") {
+      flags[name] = arg.scalar.substr(equals + 1);
+    } else {
+      other_args.push_back(arg.scalar);
+    }
+  }
+  EXPECT_EQ(flags["--http-port"], "8080");
+  EXPECT_EQ(flags["--model"], "/opt/tod/models/default") << "the bundle the Dockerfile copies";
+
+  REQUIRE_MODEL();
+  auto server = testing::ServerProcess::Start(testing::TestModel(), other_args);
+  ASSERT_TRUE(server->WaitReady()) << server->Log();
+  const auto model = server->HttpClient()->Get(
+      "/v2/models/" + fs::path(testing::TestModel()).filename().string() + "/ready");
+  ASSERT_TRUE(model);
+  EXPECT_EQ(model->status, 200) << model->body;
 }
 
 TEST(DeployTest, DockerfileFollowsTheContract) {
