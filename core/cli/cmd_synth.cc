@@ -1,5 +1,9 @@
 // tod synth --out DIR --train N --test M --seed S [--width 2048 --height 1024]
+//           [--obstacles N] [--size-m MIN MAX] [--distance-m MIN MAX]
 #include <iostream>
+#include <optional>
+#include <tuple>
+#include <utility>
 
 #include "core/cli/commands.h"
 #include "core/synth/synth.h"
@@ -11,6 +15,8 @@ Runner AddSynthCommand(CLI::App& app) {
     std::string out;
     int train = 20, test = 10, width = 2048, height = 1024;
     std::uint64_t seed = 1;
+    std::optional<int> obstacles;
+    std::optional<std::pair<double, double>> size_m, distance_m;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd =
@@ -21,10 +27,26 @@ Runner AddSynthCommand(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "random seed (same seed, same frames)");
   cmd->add_option("--width", args->width, "frame width")->check(CLI::Range(64, 8192));
   cmd->add_option("--height", args->height, "frame height")->check(CLI::Range(64, 8192));
+  // Plain scenes (the demo's: one obstacle of 20-50 cm at 10-25 m) narrow the random ranges.
+  cmd->add_option("--obstacles", args->obstacles, "obstacles per frame (default: 1 to 4)")
+      ->check(CLI::Range(0, 16));
+  cmd->add_option("--size-m", args->size_m, "obstacle size range MIN MAX, metres (0.05 0.6)")
+      ->check(CLI::Range(0.01, 5.0));
+  cmd->add_option("--distance-m", args->distance_m,
+                  "obstacle distance range MIN MAX, metres (5 60)")
+      ->check(CLI::Range(1.0, 200.0));
   return [args] {
     SynthParams params;
     params.width = args->width;
     params.height = args->height;
+    if (args->obstacles) params.min_obstacles = params.max_obstacles = *args->obstacles;
+    if (args->size_m) std::tie(params.min_size_m, params.max_size_m) = *args->size_m;
+    if (args->distance_m) {
+      std::tie(params.min_distance_m, params.max_distance_m) = *args->distance_m;
+    }
+    if (params.min_size_m > params.max_size_m || params.min_distance_m > params.max_distance_m) {
+      return Fail("--size-m and --distance-m take MIN MAX with MIN <= MAX");
+    }
     const Status st = WriteSynthDataset(
         args->out, params, args->train, args->test, args->seed, [](int done, int total) {
           if (done % 10 == 0 || done == total)
