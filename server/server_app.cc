@@ -7,9 +7,7 @@
 #include <algorithm>
 #include <condition_variable>
 #include <csignal>
-#include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <mutex>
@@ -18,6 +16,7 @@
 #include <thread>
 #include <variant>
 
+#include "core/base/atomic_file.h"
 #include "server/core/inference_engine.h"
 #include "server/core/model_holder.h"
 #include "server/grpc_frontend.h"
@@ -286,19 +285,11 @@ void LogListening(const ServerConfig& config, const Security& security, int grpc
             {"auth", security.auth ? "bearer" : "off"}});
 }
 
-// The bound ports for whoever started us (tests, supervisors) when the kernel picked them: written
-// whole to a temporary name, then renamed, so a reader never sees half a file.
+// The bound ports for whoever started us (tests, supervisors) when the kernel picked them,
+// written atomically so a reader never sees half a file.
 Status WritePortsFile(const std::string& path, int grpc_port, int http_port) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::trunc);
-    out << nlohmann::json{{"grpc", grpc_port}, {"http", http_port}}.dump() << "\n";
-    if (!out.flush()) return Status::Internal("cannot write the ports file " + temporary);
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    return Status::Internal("cannot rename " + temporary + " to " + path);
-  }
-  return Status::Ok();
+  return WriteFileAtomically(
+      path, nlohmann::json{{"grpc", grpc_port}, {"http", http_port}}.dump() + "\n");
 }
 
 }  // namespace
