@@ -17,6 +17,7 @@ BUILD_PACKAGES=(
   libgtest-dev libgmock-dev
   clang libclang-rt-14-dev
   openssl stress-ng curl
+  python3-grpcio python3-protobuf
 )
 # libboost-dev: Boost.Beast/Asio (header-only) for tod_server's REST transport.
 # libjpeg62-turbo-dev, libpng-dev, libwebp-dev: tod_server's strict image decoders.
@@ -30,6 +31,8 @@ BUILD_PACKAGES=(
 # openssl: the service tests make a throw-away CA and certificates with the openssl command.
 # curl: deploy/soak.sh (and its ctest soak_smoke) and deploy/bench_server.sh probe and scrape
 # the server with it.
+# python3-grpcio, python3-protobuf: a gRPC client this project did not write, for the ctest of
+# the Open Inference Protocol's gRPC service (stubs made with Debian's protoc and grpc_python_plugin).
 # stress-ng: loads the CPUs beside the service tests to check they hold on a busy machine.
 
 RUNTIME_PACKAGES=(

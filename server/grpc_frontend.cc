@@ -1,55 +1,15 @@
 #include "server/grpc_frontend.h"
 
-#include <chrono>
 #include <optional>
 
 #include "server/access_log.h"
 #include "server/detect_response.h"
+#include "server/grpc_call.h"
 #include "server/grpc_messages.h"
-#include "server/logging.h"
 #include "server/status_mapping.h"
 
 namespace tod::server {
 namespace {
-
-// gRPC reports the client's deadline on the system clock; the engine works on the steady clock.
-std::optional<std::chrono::steady_clock::time_point> SteadyDeadline(
-    const grpc::CallbackServerContext& context) {
-  const auto deadline = context.deadline();
-  if (deadline >= std::chrono::system_clock::time_point::max() - std::chrono::hours(24 * 365)) {
-    return std::nullopt;  // no deadline set
-  }
-  const auto remaining = deadline - std::chrono::system_clock::now();
-  return std::chrono::steady_clock::now() +
-         std::chrono::duration_cast<std::chrono::steady_clock::duration>(remaining);
-}
-
-// Why gRPC cancelled the call: its deadline passed, or the client cancelled (or went away).
-// The client's own deadline timer fires before the server's (the server counts from when the
-// request arrived), and its cancellation then reaches the server first; so a cancellation this
-// close to the deadline is the deadline's.
-constexpr std::chrono::seconds kDeadlineSlack(1);
-CancelReason CallCancelReason(const grpc::CallbackServerContext& context) {
-  return context.deadline() - kDeadlineSlack <= std::chrono::system_clock::now()
-             ? CancelReason::kDeadline
-             : CancelReason::kClientCancelled;
-}
-
-// Unary Detect: like the default reactor, plus OnCancel, which stops the request's work at its
-// next stage boundary. The reactor owns itself (the callback API's model) and is deleted in
-// OnDone, after Finish; the Cancellation is shared with the engine's job.
-class DetectReactor final : public grpc::ServerUnaryReactor {
- public:
-  DetectReactor(const grpc::CallbackServerContext& context,
-                std::shared_ptr<Cancellation> cancellation)
-      : context_(context), cancellation_(std::move(cancellation)) {}
-  void OnCancel() override { cancellation_->Cancel(CallCancelReason(context_)); }
-  void OnDone() override { delete this; }
-
- private:
-  const grpc::CallbackServerContext& context_;
-  const std::shared_ptr<Cancellation> cancellation_;
-};
 
 // One frame at a time per stream: read, run, write, read the next. Responses therefore come back
 // in request order, and a stream holds at most one queue slot.
@@ -121,20 +81,7 @@ ObstacleDiscoveryService::ObstacleDiscoveryService(InferenceEngine& engine,
 
 std::optional<grpc::Status> ObstacleDiscoveryService::Refuse(
     const grpc::CallbackServerContext& context, const char* method) {
-  if (!auth_) return std::nullopt;
-  const auto& metadata = context.client_metadata();
-  const auto header = metadata.find("authorization");
-  const std::string_view value =
-      header == metadata.end() ? std::string_view()
-                               : std::string_view(header->second.data(), header->second.size());
-  const std::optional<std::string> refused = auth_->Check(value);
-  if (!refused) return std::nullopt;
-  metrics_.RecordRejection("unauthenticated");
-  metrics_.RecordRequest("grpc", "UNAUTHENTICATED", 0);
-  LogEvent(
-      spdlog::level::warn, "unauthenticated",
-      {{"protocol", "grpc"}, {"method", method}, {"peer", context.peer()}, {"error", *refused}});
-  return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, *refused);
+  return RefuseUnauthenticated(auth_.get(), context, method, metrics_);
 }
 
 std::string ObstacleDiscoveryService::NextRequestId() {
@@ -220,7 +167,7 @@ grpc::ServerUnaryReactor* ObstacleDiscoveryService::Detect(grpc::CallbackServerC
     return reactor;
   }
   auto cancellation = std::make_shared<Cancellation>();
-  auto* reactor = new DetectReactor(*context, cancellation);  // deletes itself in OnDone
+  auto* reactor = new CancellableUnaryReactor(*context, cancellation);  // deletes itself in OnDone
   SubmitFrame(context, *request, "", std::move(cancellation), response,
               [reactor](grpc::Status status) { reactor->Finish(status); });
   return reactor;

@@ -24,6 +24,7 @@
 #include "server/http_frontend.h"
 #include "server/logging.h"
 #include "server/metrics.h"
+#include "server/oip/oip_grpc.h"
 #include "server/tls_config.h"
 #include "server/token_auth.h"
 
@@ -166,7 +167,8 @@ EngineConfig EngineConfigFrom(const ServerConfig& config) {
 // The gRPC listener with health checking and reflection, reporting not-serving until the model is
 // loaded; *port receives the bound port. Null when it cannot listen.
 std::unique_ptr<grpc::Server> StartGrpc(const ServerConfig& config, const Security& security,
-                                        ObstacleDiscoveryService& service, int* port) {
+                                        ObstacleDiscoveryService& service,
+                                        oip::OipGrpcService& oip_service, int* port) {
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
@@ -177,12 +179,14 @@ std::unique_ptr<grpc::Server> StartGrpc(const ServerConfig& config, const Securi
       port);
   builder.SetMaxReceiveMessageSize(static_cast<int>(config.max_image_bytes + kGrpcMessageSlack));
   builder.RegisterService(&service);
+  builder.RegisterService(&oip_service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server || *port == 0) return nullptr;
   grpc::HealthCheckServiceInterface* health = server->GetHealthCheckService();
   // Register the service's own name too (grpc.health.v1 answers NOT_FOUND for unknown names);
   // SetServingStatus(bool) then switches "" and this name together.
   health->SetServingStatus(tod::v1::ObstacleDiscovery::service_full_name(), false);
+  health->SetServingStatus(inference::GRPCInferenceService::service_full_name(), false);
   health->SetServingStatus(false);
   return server;
 }
@@ -314,8 +318,12 @@ int RunServer(const ServerConfig& config) {
   // Listeners come up first and report not-ready until the model is loaded, so orchestrators
   // can tell "starting" from "dead".
   ObstacleDiscoveryService service(engine, models, metrics, security.auth);
+  oip::OipGrpcService oip_service(
+      engine, models, metrics, config.max_image_bytes,
+      [&service] { return service.NextRequestId(); }, security.auth);
   int grpc_port = 0;
-  std::unique_ptr<grpc::Server> grpc_server = StartGrpc(config, security, service, &grpc_port);
+  std::unique_ptr<grpc::Server> grpc_server =
+      StartGrpc(config, security, service, oip_service, &grpc_port);
   if (!grpc_server) {
     const std::string address = config.host + ":" + std::to_string(config.grpc_port);
     LogEvent(spdlog::level::err, "cannot listen for gRPC", {{"address", address}});

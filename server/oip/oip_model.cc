@@ -4,6 +4,8 @@
 #include <array>
 #include <opencv2/core.hpp>
 
+#include "server/rest_options.h"
+
 #ifndef TOD_SERVER_VERSION
 #define TOD_SERVER_VERSION "unknown"
 #endif
@@ -33,9 +35,11 @@ OutputTensor Obstacles(const Detection& detection) {
     data.insert(data.end(), {obstacle.score, obstacle.peak_probability, obstacle.mean_probability,
                              obstacle.evidence, static_cast<float>(obstacle.area)});
   }
-  return {kObstaclesOutput,
-          {static_cast<int64_t>(detection.obstacles.size()), kObstacleWidth},
-          std::move(data)};
+  OutputTensor tensor{kObstaclesOutput,
+                      {static_cast<int64_t>(detection.obstacles.size()), kObstacleWidth},
+                      std::move(data)};
+  tensor.parameters = {{"columns", kObstacleColumns}};
+  return tensor;
 }
 
 OutputTensor Proposals(const Detection& detection) {
@@ -45,9 +49,11 @@ OutputTensor Proposals(const Detection& detection) {
     AppendBox(proposal.box, &data);
     data.insert(data.end(), {proposal.fused, proposal.ordr, proposal.obdr});
   }
-  return {kProposalsOutput,
-          {static_cast<int64_t>(detection.proposals.size()), kProposalWidth},
-          std::move(data)};
+  OutputTensor tensor{kProposalsOutput,
+                      {static_cast<int64_t>(detection.proposals.size()), kProposalWidth},
+                      std::move(data)};
+  tensor.parameters = {{"columns", kProposalColumns}};
+  return tensor;
 }
 
 Result<OutputTensor> Map(const InferRequest& request, const InferenceResult& result) {
@@ -72,6 +78,30 @@ json TensorMetadata(std::string_view name, std::string_view datatype, std::vecto
 }
 
 }  // namespace
+
+Result<std::shared_ptr<const LoadedModel>> ResolveModel(const ModelHolder& models,
+                                                        std::string_view name,
+                                                        std::optional<std::string_view> version) {
+  std::shared_ptr<const LoadedModel> model = models.Current();
+  if (!model) return Status::Unavailable("model not loaded yet");
+  const ModelInfo& info = model->detector->info();
+  if (name != info.name) return Status::NotFound("unknown model '" + std::string(name) + "'");
+  if (version && *version != ModelVersion(info)) {
+    return Status::NotFound("model '" + std::string(name) + "' has no version '" +
+                            std::string(*version) + "'");
+  }
+  return model;
+}
+
+Status ApplyOptions(const InferRequest& request, InferenceRequest* inference,
+                    std::string* frame_id) {
+  const Status parsed = ParseDetectQuery(request.options, inference, frame_id);
+  if (parsed.ok()) return parsed;
+  // ParseDetectQuery names "query parameter x"; here x is a request parameter.
+  std::string message = parsed.message();
+  if (message.starts_with("query parameter ")) message.erase(0, 6);
+  return Status::InvalidArgument(message);
+}
 
 std::string ModelVersion(const ModelInfo& info) {
   return info.version.empty() ? "1" : info.version;

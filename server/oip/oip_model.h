@@ -12,6 +12,7 @@
 // (boxes in pixels of the frame; area in pixels, exact in FP32 below 2^24).
 #pragma once
 
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -21,6 +22,7 @@
 #include "core/base/status.h"
 #include "core/pipeline/detector.h"
 #include "server/core/inference_engine.h"
+#include "server/core/model_holder.h"
 #include "server/oip/oip_tensors.h"
 
 namespace tod::server::oip {
@@ -28,6 +30,12 @@ namespace tod::server::oip {
 inline constexpr char kObstaclesOutput[] = "obstacles";
 inline constexpr char kProposalsOutput[] = "proposals";
 inline constexpr char kMapOutput[] = "probability_map";
+
+// The loaded model when `name` (and `version`, when given) name it: Unavailable before a model
+// is loaded, NotFound for another name or version.
+Result<std::shared_ptr<const LoadedModel>> ResolveModel(const ModelHolder& models,
+                                                        std::string_view name,
+                                                        std::optional<std::string_view> version);
 
 // The protocol's model version of a bundle.
 std::string ModelVersion(const ModelInfo& info);
@@ -40,6 +48,11 @@ nlohmann::json ModelMetadata(const ModelInfo& info);
 
 // An infer request may ask for these outputs only (InvalidArgument naming the first other one).
 Status CheckOutputs(const InferRequest& request);
+
+// The request's detection options (its parameters, named like the /v1/detect query) into
+// `inference` and `frame_id`; InvalidArgument naming the parameter when one is out of range.
+Status ApplyOptions(const InferRequest& request, InferenceRequest* inference,
+                    std::string* frame_id);
 
 // Whether the request's outputs include the probability map (else the engine skips it).
 bool WantsMap(const InferRequest& request);

@@ -8,7 +8,6 @@
 #include "server/access_log.h"
 #include "server/oip/oip_model.h"
 #include "server/oip/oip_path.h"
-#include "server/rest_options.h"
 #include "server/status_mapping.h"
 
 namespace tod::server::oip {
@@ -36,20 +35,6 @@ http::Response OipError(const Status& status) {
 
 std::string CodeName(const Status& status) { return GrpcCodeName(ToGrpcCode(status.code())); }
 
-// The loaded model when `path` names it (and its version, when the path has one): Unavailable
-// before a model is loaded, NotFound for another name or version.
-Result<std::shared_ptr<const LoadedModel>> Resolve(const ModelHolder& models,
-                                                   const ModelPath& path) {
-  std::shared_ptr<const LoadedModel> model = models.Current();
-  if (!model) return Status::Unavailable("model not loaded yet");
-  const ModelInfo& info = model->detector->info();
-  if (path.name != info.name) return Status::NotFound("unknown model '" + path.name + "'");
-  if (path.version && *path.version != ModelVersion(info)) {
-    return Status::NotFound("model '" + path.name + "' has no version '" + *path.version + "'");
-  }
-  return model;
-}
-
 http::Response WrongMethod(std::string_view path, const char* allowed) {
   http::Response response = OipError(405, std::string(path) + " allows " + allowed + " only");
   response.set(field::allow, allowed);
@@ -66,13 +51,6 @@ struct Outcome {
 
 Outcome Refusal(const Status& status) {
   return {OipError(status), CodeName(status), status.message()};
-}
-
-// ParseDetectQuery names "query parameter x"; here x is a request parameter.
-Status AsRequestParameter(const Status& status) {
-  std::string message = status.message();
-  if (message.starts_with("query parameter ")) message.erase(0, 6);
-  return Status::InvalidArgument(message);
 }
 
 }  // namespace
@@ -118,7 +96,8 @@ void OipRestApi::HandleGet(const http::IncomingRequest& request,
     respond(WrongMethod(target, "POST"));
     return;
   }
-  const Result<std::shared_ptr<const LoadedModel>> model = Resolve(models_, *path);
+  const Result<std::shared_ptr<const LoadedModel>> model =
+      ResolveModel(models_, path->name, path->version);
   if (path->action == ModelAction::kReady) {
     // A probe: answered, not counted as a request.
     if (!model.ok()) {
@@ -187,7 +166,8 @@ void OipRestApi::Infer(http::IncomingRequest incoming, http::Responder respond) 
     finish({WrongMethod(target, "GET"), "INVALID_ARGUMENT", "POST on a GET endpoint"}, frame_id);
     return;
   }
-  if (const Result<std::shared_ptr<const LoadedModel>> model = Resolve(models_, *path);
+  if (const Result<std::shared_ptr<const LoadedModel>> model =
+          ResolveModel(models_, path->name, path->version);
       !model.ok()) {
     finish(Refusal(model.status()), frame_id);
     return;
@@ -217,8 +197,8 @@ void OipRestApi::Infer(http::IncomingRequest incoming, http::Responder respond) 
   inference.cancellation = call->request.client_gone;
   inference.encode_map_png = WantsMap(request);
   if (request.id) frame_id = *request.id;  // frame_id, when given, overrides it
-  if (Status s = ParseDetectQuery(request.options, &inference, &frame_id); !s.ok()) {
-    refuse(AsRequestParameter(s));
+  if (Status s = ApplyOptions(request, &inference, &frame_id); !s.ok()) {
+    refuse(s);
     return;
   }
 

@@ -127,7 +127,7 @@ Status ReadRequestParameters(const json& request, InferRequest* out) {
   const Result<const json*> parameters = Parameters(request, "request");
   if (!parameters.ok()) return parameters.status();
   for (const auto& [name, value] : (*parameters)->items()) {
-    if (std::find(kDetectOptions.begin(), kDetectOptions.end(), name) != kDetectOptions.end()) {
+    if (IsDetectOption(name)) {
       if (value.is_string()) {
         out->options[name] = value.get<std::string>();
       } else if (value.is_number()) {
@@ -137,14 +137,10 @@ Status ReadRequestParameters(const json& request, InferRequest* out) {
         return Status::InvalidArgument("parameter " + name + " must be a number or a string");
       }
     } else if (name == "map_format") {
-      const std::string format = value.is_string() ? value.get<std::string>() : "";
-      if (format == "png") {
-        out->map_format = MapFormat::kPng;
-      } else if (format == "uint8") {
-        out->map_format = MapFormat::kUint8;
-      } else {
-        return Status::InvalidArgument("parameter map_format must be \"png\" or \"uint8\"");
-      }
+      const Result<MapFormat> format =
+          ParseMapFormat(value.is_string() ? value.get_ref<const std::string&>() : "");
+      if (!format.ok()) return format.status();
+      out->map_format = *format;
     }
   }
   const Result<bool> binary = BoolParameter(**parameters, "binary_data_output", "request");
@@ -190,32 +186,6 @@ Result<std::string_view> OnlyJsonElement(const json& data, const std::string& wh
     return Status::InvalidArgument(where + ".data must hold the image as a base64 string");
   }
   return std::string_view(element->get_ref<const std::string&>());
-}
-
-// The binary form of one BYTES element: a 4-byte little-endian length, then that many bytes,
-// filling the tensor's binary data exactly.
-Result<std::string_view> OnlyBinaryElement(std::string_view data, const std::string& where,
-                                           const BodyLimits& limits) {
-  if (data.size() < 4) {
-    return Status::InvalidArgument(where + ": " + std::to_string(data.size()) +
-                                   " bytes of binary data cannot hold a BYTES element (a 4-byte "
-                                   "length comes first)");
-  }
-  const uint32_t length = static_cast<uint32_t>(static_cast<unsigned char>(data[0])) |
-                          static_cast<uint32_t>(static_cast<unsigned char>(data[1])) << 8 |
-                          static_cast<uint32_t>(static_cast<unsigned char>(data[2])) << 16 |
-                          static_cast<uint32_t>(static_cast<unsigned char>(data[3])) << 24;
-  if (length != data.size() - 4) {
-    return Status::InvalidArgument(where + ": the BYTES element declares " +
-                                   std::to_string(length) + " bytes but its binary data holds " +
-                                   std::to_string(data.size() - 4) + " after the length");
-  }
-  if (length > limits.max_image_bytes) {
-    return Status::ResourceExhausted(where + ": the image of " + std::to_string(length) +
-                                     " bytes is over the limit of " +
-                                     std::to_string(limits.max_image_bytes) + " bytes");
-  }
-  return data.substr(4);
 }
 
 // inputs: exactly one, the BYTES image, in JSON (base64) or as binary data (the rest of the body,
@@ -284,7 +254,7 @@ Status ReadInput(const json& request, std::optional<std::string_view> binary,
         where + ".parameters.binary_data_size is " + std::to_string(declared) + " but " +
         std::to_string(binary->size()) + " bytes follow the JSON header");
   }
-  const Result<std::string_view> image = OnlyBinaryElement(*binary, where, limits);
+  const Result<std::string_view> image = OnlyBytesElement(*binary, where, limits);
   if (!image.ok()) return image.status();
   out->binary_image = *image;
   return Status::Ok();
@@ -327,23 +297,6 @@ void AppendLittleEndian32(uint32_t value, std::string* out) {
   for (int shift = 0; shift < 32; shift += 8) out->push_back(static_cast<char>(value >> shift));
 }
 
-// Appends the tensor's binary form to `out`; returns its size.
-size_t AppendBinary(const TensorData& data, std::string* out) {
-  const size_t start = out->size();
-  if (const auto* floats = std::get_if<std::vector<float>>(&data)) {
-    out->reserve(start + floats->size() * 4);
-    for (const float value : *floats) AppendLittleEndian32(std::bit_cast<uint32_t>(value), out);
-  } else if (const auto* bytes = std::get_if<std::vector<uint8_t>>(&data)) {
-    out->append(bytes->begin(), bytes->end());
-  } else {
-    for (const std::string& element : std::get<std::vector<std::string>>(data)) {
-      AppendLittleEndian32(static_cast<uint32_t>(element.size()), out);
-      out->append(element);
-    }
-  }
-  return out->size() - start;
-}
-
 json JsonData(const TensorData& data) {
   if (const auto* floats = std::get_if<std::vector<float>>(&data)) return json(*floats);
   if (const auto* bytes = std::get_if<std::vector<uint8_t>>(&data)) return json(*bytes);
@@ -355,6 +308,56 @@ json JsonData(const TensorData& data) {
 }
 
 }  // namespace
+
+bool IsDetectOption(std::string_view name) {
+  return std::find(kDetectOptions.begin(), kDetectOptions.end(), name) != kDetectOptions.end();
+}
+
+Result<MapFormat> ParseMapFormat(std::string_view text) {
+  if (text == "png") return MapFormat::kPng;
+  if (text == "uint8") return MapFormat::kUint8;
+  return Status::InvalidArgument("parameter map_format must be \"png\" or \"uint8\"");
+}
+
+Result<std::string_view> OnlyBytesElement(std::string_view data, const std::string& where,
+                                          const BodyLimits& limits) {
+  if (data.size() < 4) {
+    return Status::InvalidArgument(where + ": " + std::to_string(data.size()) +
+                                   " bytes of binary data cannot hold a BYTES element (a 4-byte "
+                                   "length comes first)");
+  }
+  const uint32_t length = static_cast<uint32_t>(static_cast<unsigned char>(data[0])) |
+                          static_cast<uint32_t>(static_cast<unsigned char>(data[1])) << 8 |
+                          static_cast<uint32_t>(static_cast<unsigned char>(data[2])) << 16 |
+                          static_cast<uint32_t>(static_cast<unsigned char>(data[3])) << 24;
+  if (length != data.size() - 4) {
+    return Status::InvalidArgument(where + ": the BYTES element declares " +
+                                   std::to_string(length) + " bytes but its binary data holds " +
+                                   std::to_string(data.size() - 4) + " after the length");
+  }
+  if (length > limits.max_image_bytes) {
+    return Status::ResourceExhausted(where + ": the image of " + std::to_string(length) +
+                                     " bytes is over the limit of " +
+                                     std::to_string(limits.max_image_bytes) + " bytes");
+  }
+  return data.substr(4);
+}
+
+std::string BinaryTensorData(const TensorData& data) {
+  std::string out;
+  if (const auto* floats = std::get_if<std::vector<float>>(&data)) {
+    out.reserve(floats->size() * 4);
+    for (const float value : *floats) AppendLittleEndian32(std::bit_cast<uint32_t>(value), &out);
+  } else if (const auto* bytes = std::get_if<std::vector<uint8_t>>(&data)) {
+    out.assign(bytes->begin(), bytes->end());
+  } else {
+    for (const std::string& element : std::get<std::vector<std::string>>(data)) {
+      AppendLittleEndian32(static_cast<uint32_t>(element.size()), &out);
+      out.append(element);
+    }
+  }
+  return out;
+}
 
 Result<InferRequest> ParseInferRequest(std::string_view body,
                                        std::optional<std::string_view> header_length,
@@ -402,7 +405,9 @@ EncodedResponse EncodeInferResponse(json head, const std::vector<OutputTensor>& 
         {"name", output.name}, {"datatype", Datatype(output.data)}, {"shape", output.shape}};
     json parameters = output.parameters;
     if (output.binary) {
-      parameters["binary_data_size"] = AppendBinary(output.data, &binary);
+      const std::string data = BinaryTensorData(output.data);
+      parameters["binary_data_size"] = data.size();
+      binary += data;
     } else {
       entry["data"] = JsonData(output.data);
     }

@@ -63,6 +63,20 @@ struct InferRequest {
   std::optional<std::string_view> binary_image;
 };
 
+// Whether a request parameter of this name is a detection option, passed to ParseDetectQuery
+// (max_proposals, obstacle_threshold, min_obstacle_score, budget_ms, map_kind, timeout_ms,
+// frame_id).
+bool IsDetectOption(std::string_view name);
+
+// The map_format parameter: "png" or "uint8"; InvalidArgument otherwise.
+Result<MapFormat> ParseMapFormat(std::string_view text);
+
+// The image in the binary form of one BYTES element: a 4-byte little-endian length, then that
+// many bytes, filling `data` exactly and within limits.max_image_bytes. `where` names the tensor
+// in messages.
+Result<std::string_view> OnlyBytesElement(std::string_view data, const std::string& where,
+                                          const BodyLimits& limits);
+
 // Parses an infer request body. `header_length` is the Inference-Header-Content-Length value
 // (nullopt: the body is all JSON). The returned request may view into `body`, which must outlive
 // it. Refusals are InvalidArgument (malformed, inconsistent) or ResourceExhausted (over a
@@ -82,6 +96,10 @@ struct OutputTensor {
 };
 
 const char* Datatype(const TensorData& data);
+
+// The tensor's binary form: little-endian FP32, UINT8 bytes, or each BYTES element prefixed by
+// its 4-byte little-endian length (the binary tensor data extension and gRPC's raw contents).
+std::string BinaryTensorData(const TensorData& data);
 
 struct EncodedResponse {
   std::string body;

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "tests/run_command.h"
 #include "tests/test_env.h"
@@ -329,6 +330,42 @@ TEST_F(CliTest, ShippedDefaultModelLoadsAndDetects) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["width"], 512);
   EXPECT_FALSE(j["proposals"].empty());
+}
+
+TEST_F(CliTest, DemoSceneFindsItsObstacleAndNoFalseOne) {
+  // What `bash deploy/run.sh` shows a newcomer (its commands exactly): the demo scene through
+  // models/synth-demo reports the one obstacle (box IoU >= 0.5) and nothing else.
+  const fs::path model = fs::path(tod::testing_env::SourceDir()) / "models" / "synth-demo";
+  CommandResult run = Shell(tod_ + " synth --out " + (out_ / "d").string() +
+                            " --train 0 --test 1 --seed 5 --obstacles 1 --size-m 0.2 0.5"
+                            " --distance-m 10 25");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::string image;
+  std::string instances;
+  for (const auto& e : fs::recursive_directory_iterator(out_ / "d")) {
+    const std::string name = e.path().filename().string();
+    if (name.ends_with("_leftImg8bit.png")) image = e.path().string();
+    if (name.ends_with("_instanceIds.png")) instances = e.path().string();
+  }
+  ASSERT_FALSE(image.empty());
+  ASSERT_FALSE(instances.empty());
+  const cv::Mat ids = cv::imread(instances, cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(ids.type(), CV_16U);
+  const cv::Rect truth = cv::boundingRect(cv::Mat(ids > 1000));  // obstacle instances: > 1000
+  ASSERT_GT(truth.area(), 0);
+
+  run = Shell(tod_ + " detect --model " + model.string() + " --out " + (out_ / "o").string() + " " +
+              image);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(out_ / "o" / (fs::path(image).stem().string() + ".json"));
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["obstacles"].size(), 1u) << j["obstacles"].dump();
+  const nlohmann::json& found = j["obstacles"][0];
+  const cv::Rect box(found["x"].get<int>(), found["y"].get<int>(), found["w"].get<int>(),
+                     found["h"].get<int>());
+  const int overlap = (box & truth).area();
+  const double iou = static_cast<double>(overlap) / (box.area() + truth.area() - overlap);
+  EXPECT_GE(iou, 0.5) << "reported " << found.dump() << ", truth " << truth;
 }
 
 }  // namespace
