@@ -27,7 +27,14 @@ std::string JsonValueAsText(const nlohmann::json& value) {
 
 const std::vector<SettingSpec>& SettingSpecs() {
   static const std::vector<SettingSpec> specs = {
-      {"model", "model", "TOD_MODEL", "Model bundle directory (required)"},
+      {"model", "model", "TOD_MODEL", "Model bundle directory (this or --model-repository)"},
+      {"model_repository", "model-repository", "TOD_MODEL_REPOSITORY",
+       "Directory of model bundles, each served by its directory name; rescanned on SIGHUP"},
+      {"default_model", "default-model", "TOD_DEFAULT_MODEL",
+       "With --model-repository: the model of requests that name none (default: 'default' when "
+       "there is one, else the first by name)"},
+      {"admin_token_file", "admin-token-file", "TOD_ADMIN_TOKEN_FILE",
+       "Bearer tokens of POST /v2/repository/models/{name}/load|unload (off without it)"},
       {"host", "host", "TOD_HOST", "Bind address for both listeners (default 0.0.0.0)"},
       {"grpc_port", "grpc-port", "TOD_GRPC_PORT", "gRPC port (default 8001)"},
       {"http_port", "http-port", "TOD_HTTP_PORT", "REST port (default 8000)"},
@@ -85,6 +92,12 @@ Status ApplySetting(const std::string& key, const std::string& value, const std:
   const std::string what = source + " " + key;
   if (key == "model") {
     config->model_dir = value;
+  } else if (key == "model_repository") {
+    config->model_repository = value;
+  } else if (key == "default_model") {
+    config->default_model = value;
+  } else if (key == "admin_token_file") {
+    config->admin_token_file = value;
   } else if (key == "host") {
     config->host = value;
   } else if (key == "grpc_port") {
@@ -293,8 +306,17 @@ Status ValidateTlsAndLogging(const ServerConfig& config) {
 }  // namespace
 
 Status ValidateServerConfig(const ServerConfig& config) {
-  if (config.model_dir.empty()) {
-    return Status::InvalidArgument("model: no model bundle given (--model DIR or TOD_MODEL)");
+  if (config.model_dir.empty() == config.model_repository.empty()) {
+    return Status::InvalidArgument(
+        config.model_dir.empty()
+            ? "model: no model bundle given (--model DIR or --model-repository DIR)"
+            : "model: give --model DIR or --model-repository DIR, not both");
+  }
+  if (!config.default_model.empty() && config.model_repository.empty()) {
+    return Status::InvalidArgument("default_model: only with --model-repository");
+  }
+  if (!config.admin_token_file.empty() && config.model_repository.empty()) {
+    return Status::InvalidArgument("admin_token_file: only with --model-repository");
   }
   for (const auto step :
        {ValidateServing, ValidateImageLimits, ValidateHttpLimits, ValidateTlsAndLogging}) {
@@ -305,6 +327,9 @@ Status ValidateServerConfig(const ServerConfig& config) {
 
 nlohmann::json ServerConfigToJson(const ServerConfig& config) {
   return {{"model", config.model_dir},
+          {"model_repository", config.model_repository},
+          {"default_model", config.default_model},
+          {"admin_token_file", config.admin_token_file},
           {"host", config.host},
           {"grpc_port", config.grpc_port},
           {"http_port", config.http_port},

@@ -14,7 +14,13 @@
 namespace tod::server {
 
 struct ServerConfig {
-  std::string model_dir;         // required
+  // The bundle to serve, or (model_repository) a directory of bundles: exactly one is given.
+  std::string model_dir;
+  std::string model_repository;
+  std::string default_model;  // repository: the model of requests that name none
+  // Bearer tokens of the repository's load/unload calls (POST /v2/repository/models/...);
+  // empty: those calls are off.
+  std::string admin_token_file;
   std::string host = "0.0.0.0";  // bind address of both listeners
   int grpc_port = 8001;
   int http_port = 8000;

@@ -111,6 +111,7 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
   const RequestOptions options = OptionsFromProto(request->options());
   InferenceRequest inference;
   inference.image = request->image();
+  inference.model = request->model();
   inference.options = options.detect;
   inference.encode_map_png = options.encode_map_png;
   inference.deadline = SteadyDeadline(*context);
@@ -192,11 +193,13 @@ grpc::ServerUnaryReactor* ObstacleDiscoveryService::GetModelInfo(
   }
   grpc::Status status;
   tod::v1::GetModelInfoRequest parsed;
-  const std::shared_ptr<const LoadedModel> model = models_.Current();
   if (Status valid = ParseMessage(*request, &parsed); !valid.ok()) {
     status = ToGrpcStatus(valid);
-  } else if (!model) {
+  } else if (models_.empty()) {
     status = grpc::Status(grpc::StatusCode::UNAVAILABLE, "model not loaded yet");
+  } else if (const std::shared_ptr<const LoadedModel> model = models_.Find(parsed.model());
+             !model) {
+    status = grpc::Status(grpc::StatusCode::NOT_FOUND, "unknown model '" + parsed.model() + "'");
   } else {
     tod::v1::ModelInfo info;
     FillModelInfo(*model, &info);

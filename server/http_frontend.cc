@@ -11,6 +11,7 @@
 #include "server/http/http_server.h"
 #include "server/http/query_string.h"
 #include "server/logging.h"
+#include "server/oip/oip_repository.h"
 #include "server/oip/oip_rest.h"
 #include "server/rest_options.h"
 #include "server/status_mapping.h"
@@ -90,15 +91,16 @@ AccessRecord RestAccess(const http::IncomingRequest& request, const std::string&
 // The REST handlers, stateless apart from the references they answer from.
 class RestApi {
  public:
-  RestApi(const HttpFrontendConfig& config, InferenceEngine& engine, const ModelHolder& models,
+  RestApi(const HttpFrontendConfig& config, InferenceEngine& engine, ModelHolder& models,
           ServerMetrics& metrics, std::atomic<uint64_t>& counter)
       : config_(config),
         engine_(engine),
         models_(models),
         metrics_(metrics),
         counter_(counter),
-        oip_(config.retry_after_s, config.limits.max_body_bytes, engine, models, metrics, counter) {
-  }
+        oip_(config.retry_after_s, config.limits.max_body_bytes, engine, models, metrics, counter),
+        repository_(std::make_unique<oip::OipRepositoryApi>(models, config.admin,
+                                                            config.on_models_changed)) {}
 
   http::Router Routes() const {
     http::Router router;
@@ -109,8 +111,9 @@ class RestApi {
                [this](http::IncomingRequest request, http::Responder r) {
                  Detect(std::move(request), std::move(r), /*map_only=*/true);
                });
-    router.Add(verb::get, "/v1/model",
-               [this](http::IncomingRequest, http::Responder r) { r(Model()); });
+    router.Add(verb::get, "/v1/model", [this](http::IncomingRequest request, http::Responder r) {
+      r(Model(request));
+    });
     router.Add(verb::get, "/v2/health/live", [](http::IncomingRequest, http::Responder r) {
       r(http::ContentResponse(R"({"live":true})", kJson));
     });
@@ -122,16 +125,25 @@ class RestApi {
     router.Add(verb::get, "/metrics", [this](http::IncomingRequest, http::Responder r) {
       r(http::ContentResponse(metrics_.SerializeText(), "text/plain; version=0.0.4"));
     });
-    oip_.AddRoutes(&router);  // the Open Inference Protocol: /v2, /v2/models/...
+    oip_.AddRoutes(&router);          // the Open Inference Protocol: /v2, /v2/models/...
+    repository_->AddRoutes(&router);  // and its repository extension: /v2/repository/...
     return router;
   }
 
  private:
-  http::Response Model() const {
-    const std::shared_ptr<const LoadedModel> model = models_.Current();
-    if (!model) {
+  // GET /v1/model[?model=NAME]: the default model's info, or the named one's.
+  http::Response Model(const http::IncomingRequest& request) const {
+    if (models_.empty()) {
       metrics_.RecordRequest("http", "UNAVAILABLE", 0);
       return http::JsonErrorResponse(503, "UNAVAILABLE", "model not loaded yet");
+    }
+    const QueryParams query = http::ParseQuery(request.message.target());
+    const auto named = query.find("model");
+    const std::string name = named == query.end() ? "" : named->second;
+    const std::shared_ptr<const LoadedModel> model = models_.Find(name);
+    if (!model) {
+      metrics_.RecordRequest("http", "NOT_FOUND", 0);
+      return http::JsonErrorResponse(404, "NOT_FOUND", "unknown model '" + name + "'");
     }
     tod::v1::ModelInfo info;
     FillModelInfo(*model, &info);
@@ -198,10 +210,11 @@ class RestApi {
   ServerMetrics& metrics_;
   std::atomic<uint64_t>& counter_;
   const oip::OipRestApi oip_;
+  const std::unique_ptr<oip::OipRepositoryApi> repository_;
 };
 
-HttpFrontend::HttpFrontend(HttpFrontendConfig config, InferenceEngine& engine,
-                           const ModelHolder& models, ServerMetrics& metrics)
+HttpFrontend::HttpFrontend(HttpFrontendConfig config, InferenceEngine& engine, ModelHolder& models,
+                           ServerMetrics& metrics)
     : config_(config),
       engine_(engine),
       models_(models),

@@ -17,6 +17,7 @@
 #include <boost/asio/ssl/context.hpp>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -42,11 +43,15 @@ struct HttpFrontendConfig {
   // When set, /v1/*, /v2 and /v2/models/* need a bearer token (checked from the header, before
   // the body is read); /v2/health/* and /metrics stay open for probes and scrapers.
   std::shared_ptr<const TokenAuthenticator> auth;
+  // The tokens of the model repository calls (/v2/repository/..., oip/oip_repository.h); null:
+  // those calls are refused. Told what a repository call changed.
+  std::shared_ptr<const TokenAuthenticator> admin;
+  std::function<void(const RepositoryChanges&)> on_models_changed = [](const RepositoryChanges&) {};
 };
 
 class HttpFrontend {
  public:
-  HttpFrontend(HttpFrontendConfig config, InferenceEngine& engine, const ModelHolder& models,
+  HttpFrontend(HttpFrontendConfig config, InferenceEngine& engine, ModelHolder& models,
                ServerMetrics& metrics);
   ~HttpFrontend();
   HttpFrontend(const HttpFrontend&) = delete;
@@ -63,7 +68,7 @@ class HttpFrontend {
  private:
   const HttpFrontendConfig config_;
   InferenceEngine& engine_;
-  const ModelHolder& models_;
+  ModelHolder& models_;
   ServerMetrics& metrics_;
   std::atomic<uint64_t> request_counter_{0};
   std::unique_ptr<RestApi> api_;              // the handlers the routes call

@@ -67,7 +67,7 @@ ServerMetrics::ServerMetrics()
                             .Add({})),
       model_info_(prometheus::BuildGauge()
                       .Name("tod_model_info")
-                      .Help("The model serving (value 1), labelled with name, version, generation")
+                      .Help("The models serving (value 1), labelled with name, version, generation")
                       .Register(*registry_)),
       reloads_(prometheus::BuildCounter()
                    .Name("tod_model_reloads_total")
@@ -76,7 +76,11 @@ ServerMetrics::ServerMetrics()
       token_reloads_(prometheus::BuildCounter()
                          .Name("tod_auth_token_reloads_total")
                          .Help("Bearer token file reloads (SIGHUP) by result")
-                         .Register(*registry_)) {
+                         .Register(*registry_)),
+      model_frames_(prometheus::BuildCounter()
+                        .Name("tod_model_frames_total")
+                        .Help("Frames detected, by the model that served them")
+                        .Register(*registry_)) {
   // Every reason from the start, so dashboards and alerts see 0 rather than no series.
   for (const CancelReason reason : kAllCancelReasons)
     cancelled_.Add({{"reason", CancelReasonName(reason)}});
@@ -119,21 +123,27 @@ void ServerMetrics::OnCancelled(CancelReason reason) {
   cancelled_.Add({{"reason", CancelReasonName(reason)}}).Increment();
 }
 
-void ServerMetrics::OnDetected(const StageTimes& timings,
+void ServerMetrics::OnDetected(const std::string& model, const StageTimes& timings,
                                const std::vector<std::string>& degraded_stages) {
+  model_frames_.Add({{"model", model}}).Increment();
   for (const auto& [stage, ms] : timings) {
     stage_duration_.Add({{"stage", stage}}, LatencyBuckets()).Observe(ms / 1000.0);
   }
   for (const std::string& stage : degraded_stages) degraded_.Add({{"stage", stage}}).Increment();
 }
 
-void ServerMetrics::SetModel(const std::string& name, const std::string& version, int generation) {
-  // One series only: drop the previous model's labels.
+void ServerMetrics::SetModels(const std::vector<ModelSeries>& models) {
+  // Only the models loaded now: drop the series of unloaded ones and of older generations.
   std::lock_guard lock(model_mutex_);
-  if (model_series_ != nullptr) model_info_.Remove(model_series_);
-  model_series_ = &model_info_.Add(
-      {{"name", name}, {"version", version}, {"generation", std::to_string(generation)}});
-  model_series_->Set(1);
+  for (prometheus::Gauge* series : model_series_) model_info_.Remove(series);
+  model_series_.clear();
+  for (const ModelSeries& model : models) {
+    prometheus::Gauge& series = model_info_.Add({{"name", model.name},
+                                                 {"version", model.version},
+                                                 {"generation", std::to_string(model.generation)}});
+    series.Set(1);
+    model_series_.push_back(&series);
+  }
 }
 
 void ServerMetrics::RecordReload(bool ok) {

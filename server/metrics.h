@@ -33,7 +33,7 @@ class ServerMetrics final : public EngineObserver {
   void OnFinished() override;
   void OnRejected(Rejection rejection) override;
   void OnCancelled(CancelReason reason) override;
-  void OnDetected(const StageTimes& timings,
+  void OnDetected(const std::string& model, const StageTimes& timings,
                   const std::vector<std::string>& degraded_stages) override;
 
   // One finished request. protocol: "grpc" | "http"; code: the gRPC code name ("OK", ...).
@@ -44,7 +44,14 @@ class ServerMetrics final : public EngineObserver {
   // The HTTP transport refused a request or connection (http::RefusalReasonName).
   void RecordHttpRefusal(const std::string& reason);
   void SetHttpConnections(double open);
-  void SetModel(const std::string& name, const std::string& version, int generation);
+  // tod_model_info: one series per loaded model (name, version, generation); SetModels replaces
+  // them all with `models`.
+  struct ModelSeries {
+    std::string name;
+    std::string version;
+    int generation = 0;
+  };
+  void SetModels(const std::vector<ModelSeries>& models);
   void RecordReload(bool ok);
   void RecordTokenReload(bool ok);
 
@@ -66,8 +73,9 @@ class ServerMetrics final : public EngineObserver {
   prometheus::Family<prometheus::Gauge>& model_info_;
   prometheus::Family<prometheus::Counter>& reloads_;
   prometheus::Family<prometheus::Counter>& token_reloads_;
+  prometheus::Family<prometheus::Counter>& model_frames_;
   std::mutex model_mutex_;                     // guards model_series_
-  prometheus::Gauge* model_series_ = nullptr;  // the one tod_model_info series (registry owns it)
+  std::vector<prometheus::Gauge*> model_series_;  // the tod_model_info series (registry owns them)
 };
 
 }  // namespace tod::server

@@ -91,6 +91,9 @@ Status ParseDetectQuery(const QueryParams& query, InferenceRequest* inference,
         std::chrono::steady_clock::now() + std::chrono::milliseconds(**timeout_ms);
   }
   if (const auto id = query.find("frame_id"); id != query.end()) *frame_id = id->second;
+  if (const auto model = query.find("model"); model != query.end()) {
+    inference->model = model->second;
+  }
   return Status::Ok();
 }
 

@@ -44,17 +44,50 @@ sigset_t ServerSignals() {
 // the image limit reach the engine and get our explanatory RESOURCE_EXHAUSTED instead.
 constexpr size_t kGrpcMessageSlack = 1u << 20;
 
-void PublishModel(const ModelHolder& models, ServerMetrics& metrics) {
-  const std::shared_ptr<const LoadedModel> model = models.Current();
-  if (!model) return;
-  const ModelInfo& info = model->detector->info();
-  metrics.SetModel(info.name, info.version, model->generation);
-  LogEvent(spdlog::level::info, "model loaded",
-           {{"dir", model->model_dir},
-            {"name", info.name},
-            {"version", info.version},
-            {"generation", model->generation},
-            {"warm_up_ms", static_cast<long long>(model->warm_up_ms + 0.5)}});
+// tod_model_info for the models loaded now, and a log line for each model `changes` names
+// (`refused_event` for the refused ones).
+void PublishModels(const ModelHolder& models, const RepositoryChanges& changes,
+                   ServerMetrics& metrics,
+                   const char* refused_event =
+                       "reload refused; the previous model of its name "
+                       "(if any) keeps serving") {
+  std::vector<ServerMetrics::ModelSeries> series;
+  for (const std::shared_ptr<const LoadedModel>& model : models.Models()) {
+    const ModelInfo& info = model->detector->info();
+    series.push_back({info.name, info.version, model->generation});
+    const auto& changed = changes.loaded;
+    const auto& swapped = changes.swapped;
+    if (std::find(changed.begin(), changed.end(), info.name) == changed.end() &&
+        std::find(swapped.begin(), swapped.end(), info.name) == swapped.end()) {
+      continue;
+    }
+    LogEvent(spdlog::level::info, "model loaded",
+             {{"dir", model->model_dir},
+              {"name", info.name},
+              {"version", info.version},
+              {"generation", model->generation},
+              {"warm_up_ms", static_cast<long long>(model->warm_up_ms + 0.5)}});
+  }
+  metrics.SetModels(series);
+  for (const std::string& name : changes.unloaded) {
+    LogEvent(spdlog::level::info, "model unloaded", {{"name", name}});
+  }
+  for (const auto& [name, refused] : changes.refused) {
+    LogEvent(spdlog::level::err, refused_event, {{"name", name}, {"error", refused.ToString()}});
+  }
+}
+
+// The model or the repository of `config`; on failure nothing serves.
+Result<RepositoryChanges> LoadModels(const ServerConfig& config, ModelHolder& models) {
+  if (!config.model_repository.empty()) {
+    return models.LoadRepository(config.model_repository, config.default_model);
+  }
+  if (Status loaded = models.Load(config.model_dir); !loaded.ok()) {
+    return loaded.WithContext("cannot load model bundle " + config.model_dir);
+  }
+  RepositoryChanges changes;
+  changes.loaded.push_back(models.Current()->name());
+  return changes;
 }
 
 std::chrono::milliseconds Milliseconds(double seconds) {
@@ -125,6 +158,7 @@ int Refuse(const char* event, const std::string& log_error, const std::string& m
 struct Security {
   std::optional<TlsMaterial> tls;
   std::shared_ptr<TokenAuthenticator> auth;
+  std::shared_ptr<TokenAuthenticator> admin;  // the repository's load/unload calls
 };
 
 // TLS files and tokens are checked before anything listens: a typo must not start a server that
@@ -149,6 +183,17 @@ std::variant<Security, int> LoadSecurity(const ServerConfig& config) {
     }
     security.auth = std::move(*loaded);
     LogEvent(spdlog::level::info, "auth tokens loaded", {{"tokens", security.auth->token_count()}});
+  }
+  if (!config.admin_token_file.empty()) {
+    Result<std::shared_ptr<TokenAuthenticator>> loaded =
+        TokenAuthenticator::FromFile(config.admin_token_file);
+    if (!loaded.ok()) {
+      const std::string& error = loaded.status().message();
+      return Refuse("admin tokens refused", error, error, 2);
+    }
+    security.admin = std::move(*loaded);
+    LogEvent(spdlog::level::info, "admin tokens loaded",
+             {{"tokens", security.admin->token_count()}});
   }
   return security;
 }
@@ -197,41 +242,42 @@ HttpFrontendConfig HttpConfigFrom(const ServerConfig& config, const Security& se
   http.retry_after_s = config.retry_after_s;
   http.io_threads = config.http_threads;
   http.auth = security.auth;
+  http.admin = security.admin;
   return http;
 }
 
-// SIGHUP: the model bundle and the tokens again; a refused one leaves the previous in service.
+// SIGHUP: the model bundle (or the repository) and the tokens again; a refused bundle leaves
+// the previous one of its name in service.
 void Reload(const ServerConfig& config, ModelHolder& models, ServerMetrics& metrics,
-            TokenAuthenticator* auth) {
-  LogEvent(spdlog::level::info, "reloading model", {{"dir", config.model_dir}});
-  const Status reloaded = models.Reload();
-  metrics.RecordReload(reloaded.ok());
-  if (reloaded.ok()) {
-    PublishModel(models, metrics);
-  } else {
-    LogEvent(spdlog::level::err, "reload refused; the previous model keeps serving",
-             {{"error", reloaded.ToString()}});
-  }
-  if (auth == nullptr) return;
-  const Status tokens = auth->Reload();
-  metrics.RecordTokenReload(tokens.ok());
-  if (tokens.ok()) {
-    LogEvent(spdlog::level::info, "auth tokens reloaded", {{"tokens", auth->token_count()}});
-  } else {
-    LogEvent(spdlog::level::err, "token reload refused; the previous tokens stay",
-             {{"error", tokens.message()}});
+            const std::vector<TokenAuthenticator*>& token_files) {
+  LogEvent(spdlog::level::info, "reloading models",
+           {{"dir", config.model_repository.empty() ? config.model_dir : config.model_repository}});
+  const RepositoryChanges changes = models.Reload();
+  metrics.RecordReload(changes.refused.empty());
+  PublishModels(models, changes, metrics);
+  for (TokenAuthenticator* auth : token_files) {
+    if (auth == nullptr) continue;
+    const Status tokens = auth->Reload();
+    metrics.RecordTokenReload(tokens.ok());
+    if (tokens.ok()) {
+      LogEvent(spdlog::level::info, "auth tokens reloaded",
+               {{"file", auth->path()}, {"tokens", auth->token_count()}});
+    } else {
+      LogEvent(spdlog::level::err, "token reload refused; the previous tokens stay",
+               {{"file", auth->path()}, {"error", tokens.message()}});
+    }
   }
 }
 
 // Serves until SIGTERM or SIGINT (returned), reloading on every SIGHUP.
 int ServeUntilStopSignal(const ServerConfig& config, ModelHolder& models, ServerMetrics& metrics,
-                         TokenAuthenticator* auth) {
+                         const std::vector<TokenAuthenticator*>& token_files) {
   const sigset_t signals = ServerSignals();
   for (;;) {
     int signal_number = 0;
     if (sigwait(&signals, &signal_number) != 0) continue;
     if (signal_number != SIGHUP) return signal_number;
-    Reload(config, models, metrics, auth);
+    Reload(config, models, metrics, token_files);
   }
 }
 
@@ -337,6 +383,9 @@ int RunServer(const ServerConfig& config) {
     grpc_server->Shutdown();
     return 2;
   }
+  http_config->on_models_changed = [&models, &metrics](const RepositoryChanges& changes) {
+    PublishModels(models, changes, metrics);
+  };
   HttpFrontend http(*http_config, engine, models, metrics);
   if (Status bound = http.Bind(config.host, config.http_port); !bound.ok()) {
     grpc_server->Shutdown();
@@ -352,17 +401,18 @@ int RunServer(const ServerConfig& config) {
     }
   }
 
-  if (Status loaded = models.Load(config.model_dir); !loaded.ok()) {
+  const Result<RepositoryChanges> loaded = LoadModels(config, models);
+  if (!loaded.ok()) {
     http.Stop();
     grpc_server->Shutdown();
-    return Refuse("model bundle refused", loaded.ToString(),
-                  "cannot load model bundle " + config.model_dir + ": " + loaded.ToString(), 1);
+    return Refuse("model bundle refused", loaded.status().ToString(), loaded.status().message(), 1);
   }
-  PublishModel(models, metrics);
+  PublishModels(models, *loaded, metrics, "model refused; the other models serve");
   grpc_server->GetHealthCheckService()->SetServingStatus(true);
   LogEvent(spdlog::level::info, "ready");
 
-  const int stop_signal = ServeUntilStopSignal(config, models, metrics, security.auth.get());
+  const int stop_signal =
+      ServeUntilStopSignal(config, models, metrics, {security.auth.get(), security.admin.get()});
   LogEvent(spdlog::level::info, "draining",
            {{"signal", stop_signal == SIGTERM ? "SIGTERM" : "SIGINT"},
             {"queued", engine.queue_depth()},

@@ -31,9 +31,10 @@ class EngineObserver {
   virtual void OnRejected(Rejection rejection) = 0;
   // The work of a request was stopped or skipped for `reason` (also reported as a rejection).
   virtual void OnCancelled(CancelReason reason) = 0;
-  // A request produced a detection: its stage times in ms ("queue", "decode", the pipeline's
-  // stages, "encode_map") and the stages its frame budget cut short.
-  virtual void OnDetected(const StageTimes& timings,
+  // A request produced a detection with the model named `model`: its stage times in ms
+  // ("queue", "decode", the pipeline's stages, "encode_map") and the stages its frame budget
+  // cut short.
+  virtual void OnDetected(const std::string& model, const StageTimes& timings,
                           const std::vector<std::string>& degraded_stages) = 0;
 };
 

@@ -150,6 +150,10 @@ std::optional<InferenceResult> InferenceEngine::AdmissionRefusal(
   if (Status valid = ValidateOptions(request.options); !valid.ok()) {
     return Refusal(std::move(valid), Rejection::kBadRequest);
   }
+  if (!request.model.empty() && models_.Find(request.model) == nullptr) {
+    return Refusal(Status::NotFound("unknown model '" + request.model + "'"),
+                   Rejection::kUnknownModel);
+  }
   if (request.image.size() > config_.limits.max_bytes) {
     return Refusal(Status::ResourceExhausted("image: " + std::to_string(request.image.size()) +
                                              " bytes is over the limit of " +
@@ -247,9 +251,14 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
   }
   InferenceResult result;
   result.timings.emplace_back("queue", queue_ms);
-  result.model = models_.Current();  // this request's model, whatever reloads happen meanwhile
-  if (!result.model) {
-    return Refusal(Status::Unavailable("no model loaded"), Rejection::kNotReady);
+  // This request's model, whatever reloads happen meanwhile.
+  result.model = models_.Find(request.model);
+  if (!result.model && request.model.empty()) {
+    return Refusal(Status::Unavailable("no default model loaded"), Rejection::kNotReady);
+  }
+  if (!result.model) {  // unloaded while the request waited
+    return Refusal(Status::NotFound("model '" + request.model + "' was unloaded"),
+                   Rejection::kUnknownModel);
   }
 
   const Clock::time_point started = Clock::now();  // the frame budget counts from here
@@ -288,13 +297,15 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
     result.map_png = std::move(*png);
     result.timings.emplace_back("encode_map", MillisecondsSince(encode_start));
   }
-  if (observer_ != nullptr) observer_->OnDetected(result.timings, result.detection.degraded_stages);
+  if (observer_ != nullptr) {
+    observer_->OnDetected(result.model->name(), result.timings, result.detection.degraded_stages);
+  }
   return result;
 }
 
 bool InferenceEngine::Ready() const {
   std::lock_guard lock(mutex_);
-  return !draining_ && !stopping_ && models_.Current() != nullptr;
+  return !draining_ && !stopping_ && !models_.empty();
 }
 
 void InferenceEngine::BeginDrain() {

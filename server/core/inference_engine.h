@@ -34,6 +34,7 @@ namespace tod::server {
 
 struct InferenceRequest {
   std::string_view image;  // encoded JPEG/PNG; must stay valid until the completion has run
+  std::string model;       // the model's name (ModelHolder::Find); empty: the default model
   DetectOptions options;
   bool encode_map_png = true;
   std::optional<std::chrono::steady_clock::time_point> deadline;

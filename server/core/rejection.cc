@@ -16,6 +16,8 @@ const char* RejectionName(Rejection rejection) {
       return "bad_image";
     case Rejection::kBadRequest:
       return "bad_request";
+    case Rejection::kUnknownModel:
+      return "unknown_model";
     case Rejection::kDeadline:
       return "deadline";
     case Rejection::kCancelled:

@@ -11,6 +11,7 @@ enum class Rejection {
   kTooLarge,    // byte or pixel limit                -> RESOURCE_EXHAUSTED / 413
   kBadImage,    // empty / undecodable                -> INVALID_ARGUMENT / 400
   kBadRequest,  // invalid option                     -> INVALID_ARGUMENT / 400
+  kUnknownModel,  // no model of the request's name     -> NOT_FOUND / 404
   kDeadline,    // deadline passed (queued or running) -> DEADLINE_EXCEEDED / 504
   kCancelled,   // client gone, or the drain timeout   -> CANCELLED / 499, UNAVAILABLE / 503
   kInternal,    // pipeline failure                   -> INTERNAL / 500

@@ -182,6 +182,7 @@ grpc::ServerUnaryReactor* OipGrpcService::ModelInfer(grpc::CallbackServerContext
     refuse(s);
     return reactor;
   }
+  inference.model = message.model_name();
   ApplyCallDeadline(*context, &inference);
   access.bytes = request.image().size();
 

@@ -30,8 +30,12 @@
 
 namespace tod::server::oip {
 
-using OipGrpcServiceBase = inference::GRPCInferenceService::WithRawCallbackMethod_ModelInfer<
-    inference::GRPCInferenceService::CallbackService>;
+// The five metadata methods typed, ModelInfer raw (the typed ModelInfer is never in the chain).
+using Inference = inference::GRPCInferenceService;
+using OipGrpcServiceBase = Inference::WithCallbackMethod_ServerLive<
+    Inference::WithCallbackMethod_ServerReady<Inference::WithCallbackMethod_ModelReady<
+        Inference::WithCallbackMethod_ServerMetadata<Inference::WithCallbackMethod_ModelMetadata<
+            Inference::WithRawCallbackMethod_ModelInfer<Inference::Service>>>>>>;
 
 class OipGrpcService final : public OipGrpcServiceBase {
  public:

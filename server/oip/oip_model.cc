@@ -82,11 +82,10 @@ json TensorMetadata(std::string_view name, std::string_view datatype, std::vecto
 Result<std::shared_ptr<const LoadedModel>> ResolveModel(const ModelHolder& models,
                                                         std::string_view name,
                                                         std::optional<std::string_view> version) {
-  std::shared_ptr<const LoadedModel> model = models.Current();
-  if (!model) return Status::Unavailable("model not loaded yet");
-  const ModelInfo& info = model->detector->info();
-  if (name != info.name) return Status::NotFound("unknown model '" + std::string(name) + "'");
-  if (version && *version != ModelVersion(info)) {
+  if (models.empty()) return Status::Unavailable("model not loaded yet");
+  std::shared_ptr<const LoadedModel> model = name.empty() ? nullptr : models.Find(name);
+  if (!model) return Status::NotFound("unknown model '" + std::string(name) + "'");
+  if (version && *version != ModelVersion(model->detector->info())) {
     return Status::NotFound("model '" + std::string(name) + "' has no version '" +
                             std::string(*version) + "'");
   }
@@ -96,7 +95,7 @@ Result<std::shared_ptr<const LoadedModel>> ResolveModel(const ModelHolder& model
 Status ApplyOptions(const InferRequest& request, InferenceRequest* inference,
                     std::string* frame_id) {
   const Status parsed = ParseDetectQuery(request.options, inference, frame_id);
-  if (parsed.ok()) return parsed;
+  if (parsed.ok()) return parsed;  // (the options hold no "model": the path names it)
   // ParseDetectQuery names "query parameter x"; here x is a request parameter.
   std::string message = parsed.message();
   if (message.starts_with("query parameter ")) message.erase(0, 6);

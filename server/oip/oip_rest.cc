@@ -56,7 +56,9 @@ Outcome Refusal(const Status& status) {
 }  // namespace
 
 bool NeedsToken(std::string_view path) {
-  return path == "/v2" || (path.starts_with("/v2/") && !path.starts_with("/v2/health/"));
+  // /v2/repository/... checks the admin tokens itself (oip_repository.h).
+  return path == "/v2" || (path.starts_with("/v2/") && !path.starts_with("/v2/health/") &&
+                           !path.starts_with("/v2/repository/"));
 }
 
 OipRestApi::OipRestApi(int retry_after_s, size_t max_image_bytes, InferenceEngine& engine,
@@ -201,6 +203,7 @@ void OipRestApi::Infer(http::IncomingRequest incoming, http::Responder respond) 
     refuse(s);
     return;
   }
+  inference.model = path->name;
 
   // Runs on a worker (or inline when refused at admission); never blocks an I/O thread.
   engine_.Submit(inference, [this, call, finish, frame_id](InferenceResult result) {

@@ -23,7 +23,7 @@
 namespace tod::server::oip {
 
 // Whether `path` is part of this API and so needs the bearer token when auth is on: /v2 and
-// /v2/models/...; /v2/health/* stays open for probes.
+// /v2/models/...; /v2/health/* stays open for probes, /v2/repository/* takes the admin tokens.
 bool NeedsToken(std::string_view path);
 
 class OipRestApi {

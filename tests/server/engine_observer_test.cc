@@ -31,9 +31,9 @@ class RecordingObserver final : public EngineObserver {
   void OnCancelled(CancelReason reason) override {
     Add(std::string("cancelled ") + CancelReasonName(reason));
   }
-  void OnDetected(const StageTimes& timings,
+  void OnDetected(const std::string& model, const StageTimes& timings,
                   const std::vector<std::string>& degraded_stages) override {
-    std::string line = "detected";
+    std::string line = "detected " + model;
     for (const auto& [stage, ms] : timings) line += " " + stage;
     for (const std::string& stage : degraded_stages) line += " degraded:" + stage;
     Add(line);
@@ -100,7 +100,7 @@ TEST_F(EngineObserverTest, ReportsADetectionFromAdmissionToAnswer) {
   EXPECT_EQ(
       observer_.events(),
       (Events{"accepted 1", "queue 0", "started",
-              "detected queue decode fake_stage encode_map degraded:regression", "finished"}));
+              "detected gated queue decode fake_stage encode_map degraded:regression", "finished"}));
 }
 
 TEST_F(EngineObserverTest, ReportsARefusalAtAdmissionAsARejectionOnly) {
@@ -176,7 +176,8 @@ TEST(ServerMetricsAsObserverTest, CountsTheEnginesEvents) {
   EXPECT_EQ(Series(metrics, "tod_rejections_total{reason=\"queue_full\"}"), 1);
   EXPECT_EQ(Series(metrics, "tod_requests_cancelled_total{reason=\"client_disconnected\"}"), 1);
   EXPECT_EQ(Series(metrics, "tod_requests_cancelled_total{reason=\"drain\"}"), 0);
-  observer.OnDetected({{"decode", 500}, {"proposals", 1500}}, {"proposals"});
+  observer.OnDetected("cam7", {{"decode", 500}, {"proposals", 1500}}, {"proposals"});
+  EXPECT_EQ(Series(metrics, "tod_model_frames_total{model=\"cam7\"}"), 1);
   EXPECT_EQ(Series(metrics, "tod_stage_duration_seconds_sum{stage=\"decode\"}"), 0.5);
   EXPECT_EQ(Series(metrics, "tod_stage_duration_seconds_count{stage=\"proposals\"}"), 1);
   EXPECT_EQ(Series(metrics, "tod_frames_degraded_total{stage=\"proposals\"}"), 1);

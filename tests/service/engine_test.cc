@@ -252,7 +252,7 @@ TEST(EngineWithoutModel, IsNotReady) {
 TEST(ModelHolderTest, FailedLoadKeepsTheCurrentModel) {
   ModelHolder models;
   models.Install(std::make_shared<testing::GatedDetector>("v1"), "/nonexistent/bundle");
-  const Status reload = models.Reload();  // the directory does not exist
+  const Status reload = models.Reload().status();  // the directory does not exist
   EXPECT_FALSE(reload.ok());
   EXPECT_NE(reload.message().find("/nonexistent/bundle"), std::string::npos) << reload.message();
   ASSERT_NE(models.Current(), nullptr);

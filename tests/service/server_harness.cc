@@ -115,8 +115,6 @@ std::unique_ptr<ServerProcess> ServerProcess::Start(const std::string& model_dir
   server->log_path_ = dir + "/server.log";
   const std::string ports_file = dir + "/ports.json";
   std::vector<std::string> argv = {BinaryPath("tod_server"),
-                                   "--model",
-                                   model_dir,
                                    "--host",
                                    "127.0.0.1",
                                    "--grpc-port",
@@ -125,6 +123,7 @@ std::unique_ptr<ServerProcess> ServerProcess::Start(const std::string& model_dir
                                    "0",
                                    "--ports-file",
                                    ports_file};
+  if (!model_dir.empty()) argv.insert(argv.end(), {"--model", model_dir});
   argv.insert(argv.end(), extra_args.begin(), extra_args.end());
   server->pid_ = Spawn(argv, server->log_path_);
   server->ReadPorts(ports_file);

@@ -46,8 +46,9 @@ ProcessResult RunCommand(const std::vector<std::string>& argv);
 
 class ServerProcess {
  public:
-  // Starts tod_server --model DIR on two free loopback ports plus `extra_args`; returns once the
-  // server listens (its ports are known) or has exited.
+  // Starts tod_server --model DIR (none when `model_dir` is empty: `extra_args` then say what to
+  // serve) on ports the kernel picks, plus `extra_args`; returns once the server listens (its
+  // ports are known) or has exited.
   static std::unique_ptr<ServerProcess> Start(const std::string& model_dir,
                                               const std::vector<std::string>& extra_args,
                                               HarnessTls tls = {});
