@@ -26,6 +26,7 @@ struct DetectArgs {
   std::string map = "png";              // png | none
   std::string map_kind = "normalized";  // normalized | calibrated
   int timeout_ms = 0;                   // 0: no deadline
+  std::string model;                    // empty: the server's default model
 };
 
 tod::v1::DetectRequest MakeRequest(const DetectArgs& args, const std::string& path,
@@ -33,6 +34,7 @@ tod::v1::DetectRequest MakeRequest(const DetectArgs& args, const std::string& pa
   tod::v1::DetectRequest request;
   request.set_image(std::move(image));
   request.set_frame_id(path);
+  request.set_model(args.model);
   if (args.max_proposals >= 0) request.mutable_options()->set_max_proposals(args.max_proposals);
   if (args.threshold >= 0) request.mutable_options()->set_obstacle_threshold(args.threshold);
   request.mutable_options()->set_map_format(args.map == "none" ? tod::v1::MAP_FORMAT_NONE
@@ -147,11 +149,11 @@ int RunDetect(const std::string& addr, const ConnectionArgs& connection, const D
   return all_ok ? 0 : 1;
 }
 
-int RunInfo(const std::string& addr, const ConnectionArgs& connection) {
+int RunInfo(const std::string& addr, const ConnectionArgs& connection, const std::string& model) {
   std::optional<tod::client::TodGrpcClient> client = Connect(addr, connection);
   if (!client) return 2;
   tod::v1::ModelInfo info;
-  const grpc::Status status = client->GetModelInfo(&info);
+  const grpc::Status status = client->GetModelInfo(&info, std::chrono::seconds(10), model);
   if (!status.ok()) {
     std::cerr << "tod_client: GetModelInfo failed: " << status.error_code() << " "
               << status.error_message() << "\n";
@@ -190,6 +192,9 @@ void AddDetectOptions(CLI::App* command, std::string* addr, DetectArgs* args) {
                    "normalized (the paper's map, peak 1 on every frame) | calibrated")
       ->check(CLI::IsMember({"normalized", "calibrated"}));
   command->add_option("--timeout-ms", args->timeout_ms, "gRPC deadline per request (0: none)");
+  command->add_option("--model", args->model,
+                      "The model to run, by name (a bundle of the server's --model-repository; "
+                      "default: the server's default model)");
 }
 
 }  // namespace
@@ -201,6 +206,7 @@ int main(int argc, char** argv) {
   DetectArgs detect_args;
   DetectArgs stream_args;
   std::string service;
+  std::string info_model;
   ConnectionArgs connection;
 
   CLI::App* detect = app.add_subcommand("detect", "Detect obstacles, one request per image");
@@ -209,6 +215,7 @@ int main(int argc, char** argv) {
   AddDetectOptions(stream, &addr, &stream_args);
   CLI::App* info = app.add_subcommand("info", "Print the serving model's info");
   info->add_option("--addr", addr, "Server gRPC address HOST:PORT")->required();
+  info->add_option("--model", info_model, "The model, by name (default: the server's default)");
   CLI::App* health = app.add_subcommand("health", "gRPC health check; exit 0 iff SERVING");
   health->add_option("--addr", addr, "Server gRPC address HOST:PORT")->required();
   health->add_option("--service", service, "Service name (default: whole server)");
@@ -220,6 +227,6 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (*detect) return RunDetect(addr, connection, detect_args, /*as_stream=*/false);
   if (*stream) return RunDetect(addr, connection, stream_args, /*as_stream=*/true);
-  if (*info) return RunInfo(addr, connection);
+  if (*info) return RunInfo(addr, connection, info_model);
   return RunHealth(addr, connection, service);
 }

@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <iostream>
 #include <memory>
@@ -44,6 +45,7 @@ struct LoadArgs {
   std::string json_path;
   std::string map = "none";
   int timeout_ms = 30000;
+  std::string model;   // empty: the server's default model
   std::string tls_ca;  // TLS (HTTPS / gRPC over TLS) when set
   std::string tls_cert;
   std::string tls_key;
@@ -56,6 +58,20 @@ struct Image {
   std::string bytes;
   std::string content_type;
 };
+
+// `text` with every byte but the unreserved ones %-escaped, for a query value.
+std::string QueryEscaped(const std::string& text) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string escaped;
+  for (const unsigned char c : text) {
+    if (std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '~') {
+      escaped.push_back(static_cast<char>(c));
+    } else {
+      escaped += {'%', kHex[c >> 4], kHex[c & 15]};
+    }
+  }
+  return escaped;
+}
 
 // One sender's connection; gRPC channels are shared, HTTP clients are per thread.
 class Sender {
@@ -81,7 +97,8 @@ class Sender {
   tod::client::LoadSample Send(const Image& image, Clock::time_point measured_from) {
     tod::client::LoadSample sample;
     if (http_) {
-      const std::string path = "/v1/detect?map=" + args_.map;
+      const std::string path = "/v1/detect?map=" + args_.map +
+                               (args_.model.empty() ? "" : "&model=" + QueryEscaped(args_.model));
       const httplib::Result result =
           http_->Post(path.c_str(), image.bytes, image.content_type.c_str());
       if (result) {
@@ -93,6 +110,7 @@ class Sender {
     } else {
       tod::v1::DetectRequest request;
       request.set_image(image.bytes);
+      request.set_model(args_.model);
       request.mutable_options()->set_map_format(args_.map == "png" ? tod::v1::MAP_FORMAT_PNG
                                                                    : tod::v1::MAP_FORMAT_NONE);
       tod::v1::DetectResponse response;
@@ -155,6 +173,9 @@ CLI::Option* AddLoadOptions(CLI::App& app, LoadArgs& args) {
   app.add_option("--json", args.json_path, "Also write the report as JSON to FILE");
   app.add_option("--map", args.map, "Probability map: none | png (default none)")
       ->check(CLI::IsMember({"png", "none"}));
+  app.add_option("--model", args.model,
+                 "The model, by name (a bundle of the server's --model-repository; default: the "
+                 "server's default model)");
   app.add_option("--timeout-ms", args.timeout_ms, "Per-request timeout (default 30000)")
       ->check(CLI::Range(1, 3600000));
   app.add_option("--tls-ca", args.tls_ca, "PEM CA of the server's certificate: use TLS");

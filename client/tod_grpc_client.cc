@@ -111,10 +111,13 @@ grpc::Status TodGrpcClient::DetectStream(
 }
 
 grpc::Status TodGrpcClient::GetModelInfo(tod::v1::ModelInfo* info,
-                                         std::chrono::milliseconds timeout) {
+                                         std::chrono::milliseconds timeout,
+                                         const std::string& model) {
   grpc::ClientContext context;
   Prepare(&context, timeout);
-  return stub_->GetModelInfo(&context, tod::v1::GetModelInfoRequest(), info);
+  tod::v1::GetModelInfoRequest request;
+  request.set_model(model);
+  return stub_->GetModelInfo(&context, request, info);
 }
 
 grpc::Status TodGrpcClient::Health(const std::string& service,

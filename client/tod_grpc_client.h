@@ -43,8 +43,10 @@ class TodGrpcClient {
   // response as it arrives. Returns the stream's final status.
   grpc::Status DetectStream(const std::vector<tod::v1::DetectRequest>& requests,
                             const std::function<void(const tod::v1::DetectResponse&)>& on_response);
+  // The info of the model named `model` (the server's default when empty).
   grpc::Status GetModelInfo(tod::v1::ModelInfo* info,
-                            std::chrono::milliseconds timeout = std::chrono::seconds(10));
+                            std::chrono::milliseconds timeout = std::chrono::seconds(10),
+                            const std::string& model = "");
   // Standard health check; service "" is the whole server.
   grpc::Status Health(const std::string& service, grpc::health::v1::HealthCheckResponse* response,
                       std::chrono::milliseconds timeout = std::chrono::seconds(5));

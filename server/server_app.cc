@@ -253,7 +253,11 @@ void Reload(const ServerConfig& config, ModelHolder& models, ServerMetrics& metr
   LogEvent(spdlog::level::info, "reloading models",
            {{"dir", config.model_repository.empty() ? config.model_dir : config.model_repository}});
   const RepositoryChanges changes = models.Reload();
-  metrics.RecordReload(changes.refused.empty());
+  // One count per bundle the reload loaded, swapped or refused (one bundle: one count).
+  for (size_t i = 0; i < changes.loaded.size() + changes.swapped.size(); ++i) {
+    metrics.RecordReload(true);
+  }
+  for (size_t i = 0; i < changes.refused.size(); ++i) metrics.RecordReload(false);
   PublishModels(models, changes, metrics);
   for (TokenAuthenticator* auth : token_files) {
     if (auth == nullptr) continue;

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -28,7 +29,8 @@ using testing::TestModel;
 // JSON).
 std::string MakeRepository() {
   const std::string repository = testing::MakeTempDir("tod_repository");
-  for (const char* name : {"a", "b"}) fs::copy(TestModel(), fs::path(repository) / name, fs::copy_options::recursive);
+  for (const char* name : {"a", "b"})
+    fs::copy(TestModel(), fs::path(repository) / name, fs::copy_options::recursive);
   fs::create_directories(fs::path(repository) / "broken");
   std::ofstream(fs::path(repository) / "broken" / "manifest.json") << "{ not json";
   return repository;
@@ -152,15 +154,29 @@ TEST(ModelRepositoryServiceTest, ServesEveryBundleByNameAndReloadsThemOneByOne) 
   EXPECT_NE(metrics.find("tod_model_info{generation=\"1\",name=\"a\""), std::string::npos);
   EXPECT_NE(metrics.find("tod_model_info{generation=\"1\",name=\"b\""), std::string::npos);
 
-  // SIGHUP: b removed (unloaded), c added (loaded), a untouched and serving throughout.
+  // SIGHUP under load on a: b removed (unloaded), c added (loaded), a untouched; every request
+  // to a is answered 200 throughout (tod_load, two senders over gRPC, for 4 s).
+  const std::string frames = testing::MakeTempDir("tod_repository_frames");
+  std::ofstream(frames + "/road.png", std::ios::binary) << testing::RoadPng();
+  const std::string report = frames + "/load.json";
+  auto load = std::async(std::launch::async, [&] {
+    return testing::RunCommand({testing::BinaryPath("tod_load"), "--addr", server->grpc_address(),
+                                "--images", frames, "--model", "a", "--concurrency", "2",
+                                "--duration", "4", "--warmup", "0", "--json", report});
+  });
+  ASSERT_TRUE(server->WaitForMetric("tod_model_frames_total{model=\"a\"}", 3)) << server->Log();
   fs::remove_all(fs::path(repository) / "b");
   fs::copy(TestModel(), fs::path(repository) / "c", fs::copy_options::recursive);
   server->Signal(SIGHUP);
-  for (int i = 0; i < 600 && http->Get("/v2/models/c/ready")->status != 200; ++i) {
-    EXPECT_EQ(PostPng(*http, "/v1/detect?model=a")->status, 200);
-  }
+  const testing::ProcessResult loaded = load.get();
+  ASSERT_EQ(loaded.exit_code, 0) << loaded.output;
+  const nlohmann::json stats = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_GT(stats["requests"].get<int>(), 0);
+  EXPECT_EQ(stats["succeeded"], stats["requests"]) << stats.dump();
+  ASSERT_TRUE(server->WaitForMetric("tod_model_reloads_total{result=\"success\"}", 1));
   EXPECT_EQ(http->Get("/v2/models/c/ready")->status, 200) << server->Log();
   EXPECT_EQ(http->Get("/v2/models/b/ready")->status, 404);
+  fs::remove_all(frames);
 
   // The admin calls: only with an admin token (the API's token is another).
   const httplib::Headers admin = {{"Authorization", "Bearer admin-token-0123456789abcdef"}};
