@@ -71,7 +71,7 @@ ServerMetrics::ServerMetrics()
                       .Register(*registry_)),
       reloads_(prometheus::BuildCounter()
                    .Name("tod_model_reloads_total")
-                   .Help("Model reload attempts by result")
+                   .Help("Bundles a reload (SIGHUP) loaded or refused, by result")
                    .Register(*registry_)),
       token_reloads_(prometheus::BuildCounter()
                          .Name("tod_auth_token_reloads_total")
