@@ -18,7 +18,7 @@ cd "$(dirname "$0")/../.."
 ROOT=$PWD
 BUILD_DIR=${FUZZ_BUILD_DIR:-build-fuzz}
 JOBS=${FUZZ_JOBS:-2}
-ALL_TARGETS="fuzz_image_decode fuzz_webp_decode fuzz_rest_request fuzz_grpc_request fuzz_model_files fuzz_manifest
+ALL_TARGETS="fuzz_image_decode fuzz_webp_decode fuzz_rest_request fuzz_grpc_request fuzz_oip_request fuzz_model_files fuzz_manifest
   fuzz_mask_reader fuzz_laf_reader fuzz_modd2_mat"
 
 seconds=5

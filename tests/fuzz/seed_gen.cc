@@ -22,6 +22,7 @@
 #include "core/pipeline/multilayer_regions.h"
 #include "core/pipeline/pipeline_params.h"
 #include "core/proposals/size_filter.h"
+#include "inference/grpc_service.pb.h"
 #include "tod/v1/obstacle_discovery.pb.h"
 
 namespace {
@@ -131,6 +132,48 @@ void RestSeeds() {
   Write("fuzz_rest_request", "ready", "GET /v2/health/ready HTTP/1.0\r\n\r\n");
   Write("fuzz_rest_request", "wrong_method",
         "PUT /v1/detect HTTP/1.1\r\nContent-Length: 0\r\n\r\n");
+}
+
+// One BYTES element in its binary form: a 4-byte little-endian length, then the bytes.
+std::string BytesElement(const std::string& bytes) {
+  std::string element;
+  for (int shift = 0; shift < 32; shift += 8) {
+    element.push_back(static_cast<char>(bytes.size() >> shift));
+  }
+  return element + bytes;
+}
+
+// The first byte picks the parser (fuzz_oip_request.cc): 0 JSON, 1 JSON + binary, 2 gRPC.
+void OipSeeds() {
+  const std::string png = Encode(".png", TinyFrame(4, 4), {});
+  const std::string json =
+      R"({"id":"f1","parameters":{"max_proposals":20,"map_format":"uint8"},)"
+      R"("inputs":[{"name":"image","datatype":"BYTES","shape":[1],"data":["iVBORw0KGgo="]}],)"
+      R"("outputs":[{"name":"obstacles"},{"name":"probability_map","parameters":{"binary_data":true}}]})";
+  Write("fuzz_oip_request", "json", std::string(1, '\0') + json);
+  const std::string header =
+      R"({"inputs":[{"name":"image","datatype":"BYTES","shape":[1],)"
+      R"("parameters":{"binary_data_size":)" +
+      std::to_string(png.size() + 4) + "}}]}";
+  const std::string length = {static_cast<char>(header.size() & 0xff),
+                              static_cast<char>(header.size() >> 8)};
+  Write("fuzz_oip_request", "binary", std::string(1, '\1') + length + header + BytesElement(png));
+
+  inference::ModelInferRequest request;
+  request.set_model_name("default");
+  request.set_id("f2");
+  (*request.mutable_parameters())["max_proposals"].set_int64_param(5);
+  (*request.mutable_parameters())["map_format"].set_string_param("png");
+  auto* input = request.add_inputs();
+  input->set_name("image");
+  input->set_datatype("BYTES");
+  input->add_shape(1);
+  request.add_raw_input_contents(BytesElement(png));
+  request.add_outputs()->set_name("proposals");
+  Write("fuzz_oip_request", "grpc_raw", std::string(1, '\2') + request.SerializeAsString());
+  request.clear_raw_input_contents();
+  input->mutable_contents()->add_bytes_contents(png);
+  Write("fuzz_oip_request", "grpc_contents", std::string(1, '\2') + request.SerializeAsString());
 }
 
 void GrpcSeeds() {
@@ -289,6 +332,7 @@ int main(int argc, char** argv) {
   ImageSeeds();
   RestSeeds();
   GrpcSeeds();
+  OipSeeds();
   ModelSeeds();
   ManifestSeeds();
   MaskSeeds();
