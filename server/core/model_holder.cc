@@ -136,7 +136,13 @@ Status ModelHolder::LoadNamed(const std::string& name, RepositoryChanges* change
   Result<std::shared_ptr<LoadedModel>> model = LoadBundle(dir);
   if (!model.ok()) {
     changes->refused.emplace_back(name, model.status());
+    std::lock_guard lock(mutex_);
+    refused_.insert_or_assign(name, model.status());
     return model.status();
+  }
+  {
+    std::lock_guard lock(mutex_);
+    refused_.erase(name);
   }
   (previous ? changes->swapped : changes->loaded).push_back(name);
   Publish(std::move(*model), /*only=*/false);
@@ -155,6 +161,7 @@ Result<RepositoryChanges> ModelHolder::LoadRepository(const std::string& reposit
     }
     std::lock_guard lock(mutex_);
     models_.clear();
+    refused_.clear();
     repository_dir_ = repository_dir;
     configured_default_ = default_name;
   }
@@ -187,6 +194,10 @@ RepositoryChanges ModelHolder::Reload() {
     changes.refused.emplace_back("", names.status());
     return changes;
   }
+  {
+    std::lock_guard lock(mutex_);
+    std::erase_if(refused_, [&](const auto& entry) { return names->count(entry.first) == 0; });
+  }
   for (const std::shared_ptr<const LoadedModel>& model : Models()) {
     if (names->count(model->name()) > 0) continue;
     std::lock_guard lock(mutex_);
@@ -196,8 +207,8 @@ RepositoryChanges ModelHolder::Reload() {
   }
   for (const std::string& name : *names) {
     const std::shared_ptr<const LoadedModel> current = Find(name);
-    if (current && current->fingerprint ==
-                       BundleFingerprint((fs::path(repository_dir()) / name).string())) {
+    if (current &&
+        current->fingerprint == BundleFingerprint((fs::path(repository_dir()) / name).string())) {
       continue;  // unchanged
     }
     // A refusal is recorded in `changes`; the other bundles load regardless.
@@ -247,6 +258,11 @@ std::vector<std::shared_ptr<const LoadedModel>> ModelHolder::Models() const {
   std::vector<std::shared_ptr<const LoadedModel>> models;
   for (const auto& [name, model] : models_) models.push_back(model);
   return models;
+}
+
+std::map<std::string, Status, std::less<>> ModelHolder::Refused() const {
+  std::lock_guard lock(mutex_);
+  return refused_;
 }
 
 bool ModelHolder::empty() const {

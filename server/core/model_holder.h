@@ -25,9 +25,9 @@ namespace tod::server {
 struct LoadedModel {
   std::shared_ptr<const Detector> detector;
   std::string model_dir;
-  int generation = 0;     // 1 for the first load of this name, +1 per successful reload
-  std::string loaded_at;  // ISO 8601 UTC
-  double warm_up_ms = 0;  // the warm-up detection run before it was published (warm_up.h)
+  int generation = 0;       // 1 for the first load of this name, +1 per successful reload
+  std::string loaded_at;    // ISO 8601 UTC
+  double warm_up_ms = 0;    // the warm-up detection run before it was published (warm_up.h)
   std::string fingerprint;  // the bundle's files (names, sizes, times): a change means "replaced"
 
   const std::string& name() const { return detector->info().name; }
@@ -35,9 +35,9 @@ struct LoadedModel {
 
 // What a repository load or reload did, bundle by bundle.
 struct RepositoryChanges {
-  std::vector<std::string> loaded;    // new names
-  std::vector<std::string> swapped;   // replaced bundles, loaded again
-  std::vector<std::string> unloaded;  // removed from the directory
+  std::vector<std::string> loaded;                      // new names
+  std::vector<std::string> swapped;                     // replaced bundles, loaded again
+  std::vector<std::string> unloaded;                    // removed from the directory
   std::vector<std::pair<std::string, Status>> refused;  // broken; the previous one (if any) stays
   // OK, or the first refusal (its message names the bundle).
   Status status() const;
@@ -71,6 +71,10 @@ class ModelHolder {
   std::shared_ptr<const LoadedModel> Find(std::string_view name) const;
   // Every loaded model, by name.
   std::vector<std::shared_ptr<const LoadedModel>> Models() const;
+  // The repository's bundles whose last load was refused, by name, with why (a model of that
+  // name may still serve its previous load); a later load that works, or the bundle's removal
+  // from the directory, takes the name off.
+  std::map<std::string, Status, std::less<>> Refused() const;
   bool empty() const;
   bool repository() const;
   std::string repository_dir() const;
@@ -88,6 +92,7 @@ class ModelHolder {
   std::mutex load_mutex_;     // one load at a time, so generations are sequential
   std::map<std::string, std::shared_ptr<const LoadedModel>, std::less<>> models_;
   std::map<std::string, int, std::less<>> generations_;  // the last generation of every name
+  std::map<std::string, Status, std::less<>> refused_;
   std::string default_name_;
   std::string configured_default_;  // --default-model, empty: chosen (ChooseDefault)
   std::string repository_dir_;      // empty: one-bundle mode

@@ -55,17 +55,17 @@ OipRepositoryApi::~OipRepositoryApi() {
 }
 
 void OipRepositoryApi::AddRoutes(http::Router* router) {
-  router->AddPrefix(verb::post, std::string(kRepositoryPrefix),
-                    [this](http::IncomingRequest request, http::Responder respond) {
-                      Handle(request, respond);
-                    });
+  router->AddPrefix(
+      verb::post, std::string(kRepositoryPrefix),
+      [this](http::IncomingRequest request, http::Responder respond) { Handle(request, respond); });
 }
 
 void OipRepositoryApi::Handle(const http::IncomingRequest& request,
                               const http::Responder& respond) {
   if (!admin_) {
-    respond(RepositoryError(403, "the model repository calls are off: start tod_server with "
-                                 "--model-repository DIR --admin-token-file FILE"));
+    respond(RepositoryError(403,
+                            "the model repository calls are off: start tod_server with "
+                            "--model-repository DIR --admin-token-file FILE"));
     return;
   }
   if (const std::optional<std::string> refused =
@@ -78,10 +78,21 @@ void OipRepositoryApi::Handle(const http::IncomingRequest& request,
   const std::string_view path = http::TargetPath(request.message.target());
   if (path == "/v2/repository/index") {
     json index = json::array();
+    const auto refused = models_.Refused();
     for (const std::shared_ptr<const LoadedModel>& model : models_.Models()) {
-      index.push_back({{"name", model->name()},
-                       {"version", ModelVersion(model->detector->info())},
-                       {"state", "READY"}});
+      json entry = {{"name", model->name()},
+                    {"version", ModelVersion(model->detector->info())},
+                    {"state", "READY"}};
+      // Serving its previous load: say why the last one was refused.
+      if (const auto it = refused.find(model->name()); it != refused.end()) {
+        entry["reason"] = it->second.ToString();
+      }
+      index.push_back(std::move(entry));
+    }
+    for (const auto& [name, status] : refused) {
+      if (models_.Find(name) == nullptr) {
+        index.push_back({{"name", name}, {"state", "UNAVAILABLE"}, {"reason", status.ToString()}});
+      }
     }
     respond(http::ContentResponse(index.dump(), kJson));
     return;

@@ -1,7 +1,8 @@
 // The Open Inference Protocol's model repository extension, for a server started with
 // --model-repository and --admin-token-file:
 //
-//   POST /v2/repository/index                         the loaded models: name, version, state
+//   POST /v2/repository/index                         the bundles: name, version, state READY
+//                                                     (serving) or UNAVAILABLE (refused; reason)
 //   POST /v2/repository/models/{name}/load            (re)load DIR/{name}: 200 {} when serving
 //   POST /v2/repository/models/{name}/unload          stop serving it: 200 {}
 //

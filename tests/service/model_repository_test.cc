@@ -63,6 +63,8 @@ TEST(ModelRepositoryTest, LoadsEveryBundleByNameAndRefusesTheBrokenOne) {
   EXPECT_EQ(models.Current()->name(), "a");  // no "default": the first by name
   EXPECT_EQ(models.Find("b")->name(), "b");
   EXPECT_EQ(models.Find("broken"), nullptr);
+  ASSERT_EQ(models.Refused().count("broken"), 1u);
+  EXPECT_EQ(models.Refused().at("broken").code(), StatusCode::kDataLoss);
 
   // Added, replaced, removed: loaded, swapped, unloaded; the unchanged one stays as it is.
   fs::copy(TestModel(), fs::path(repository) / "default", fs::copy_options::recursive);
@@ -73,6 +75,7 @@ TEST(ModelRepositoryTest, LoadsEveryBundleByNameAndRefusesTheBrokenOne) {
   EXPECT_EQ(reloaded.loaded, std::vector<std::string>{"default"});
   EXPECT_EQ(reloaded.swapped, std::vector<std::string>{"b"});
   EXPECT_TRUE(reloaded.refused.empty());
+  EXPECT_TRUE(models.Refused().empty());  // removed from the directory: forgotten
   EXPECT_EQ(models.Find("a"), a_before);
   EXPECT_EQ(models.Find("b")->generation, 2);
   EXPECT_EQ(models.Current()->name(), "default");  // "default" is the default when there
@@ -190,7 +193,14 @@ TEST(ModelRepositoryServiceTest, ServesEveryBundleByNameAndReloadsThemOneByOne) 
   EXPECT_EQ(refused->status, 404) << refused->body;
   const auto index = http->Post("/v2/repository/index", admin, "", "application/json");
   ASSERT_EQ(index->status, 200);
-  EXPECT_EQ(nlohmann::json::parse(index->body).size(), 2u) << index->body;  // a and c
+  const nlohmann::json entries = nlohmann::json::parse(index->body);
+  ASSERT_EQ(entries.size(), 3u) << index->body;  // a and c serving, broken refused
+  EXPECT_EQ(entries[0]["name"], "a");
+  EXPECT_EQ(entries[0]["state"], "READY");
+  EXPECT_EQ(entries[1]["name"], "c");
+  EXPECT_EQ(entries[2]["name"], "broken");
+  EXPECT_EQ(entries[2]["state"], "UNAVAILABLE");
+  EXPECT_NE(entries[2]["reason"].get<std::string>().find("not valid JSON"), std::string::npos);
   server->Signal(SIGTERM);
   EXPECT_EQ(server->WaitExit(30s), 0);
   const std::string log = server->Log();  // whole once the server has exited
