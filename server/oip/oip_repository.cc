@@ -3,8 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include "server/http/percent_decoding.h"
+#include "server/oip/oip_errors.h"
 #include "server/oip/oip_model.h"
-#include "server/status_mapping.h"
 
 namespace tod::server::oip {
 namespace {
@@ -13,17 +13,7 @@ using http::beast_http::field;
 using http::beast_http::verb;
 using nlohmann::json;
 
-constexpr char kJson[] = "application/json";
-
-http::Response RepositoryError(unsigned http_status, std::string_view message) {
-  return http::ContentResponse(
-      json{{"error", message}}.dump(-1, ' ', false, json::error_handler_t::replace), kJson,
-      http_status);
-}
-
-http::Response RepositoryError(const Status& status) {
-  return RepositoryError(HttpStatusFor(status, Rejection::kNone), status.message());
-}
+constexpr const char* kJson = kJsonType;
 
 // "/v2/repository/models/{name}/{load|unload}" -> name and action; nullopt for other paths.
 struct ModelCall {
@@ -63,14 +53,14 @@ void OipRepositoryApi::AddRoutes(http::Router* router) {
 void OipRepositoryApi::Handle(const http::IncomingRequest& request,
                               const http::Responder& respond) {
   if (!admin_) {
-    respond(RepositoryError(403,
-                            "the model repository calls are off: start tod_server with "
-                            "--model-repository DIR --admin-token-file FILE"));
+    respond(OipError(403,
+                     "the model repository calls are off: start tod_server with "
+                     "--model-repository DIR --admin-token-file FILE"));
     return;
   }
   if (const std::optional<std::string> refused =
           admin_->Check(request.message[field::authorization])) {
-    http::Response response = RepositoryError(401, *refused);
+    http::Response response = OipError(401, *refused);
     response.set(field::www_authenticate, "Bearer");
     respond(std::move(response));
     return;
@@ -94,12 +84,12 @@ void OipRepositoryApi::Handle(const http::IncomingRequest& request,
         index.push_back({{"name", name}, {"state", "UNAVAILABLE"}, {"reason", status.ToString()}});
       }
     }
-    respond(http::ContentResponse(index.dump(), kJson));
+    respond(http::ContentResponse(Dump(index), kJson));
     return;
   }
   const std::optional<ModelCall> call = ParseModelCall(path);
   if (!call) {
-    respond(RepositoryError(404, "no such endpoint: " + std::string(path)));
+    respond(OipError(404, "no such endpoint: " + std::string(path)));
     return;
   }
   if (call->action == "load") {
@@ -108,7 +98,7 @@ void OipRepositoryApi::Handle(const http::IncomingRequest& request,
   }
   const Status unloaded = models_.UnloadModel(call->name);
   if (!unloaded.ok()) {
-    respond(RepositoryError(unloaded));
+    respond(OipError(unloaded));
     return;
   }
   RepositoryChanges changes;
@@ -120,7 +110,7 @@ void OipRepositoryApi::Handle(const http::IncomingRequest& request,
 void OipRepositoryApi::Load(const std::string& name, const http::Responder& respond) {
   std::lock_guard lock(loader_mutex_);
   if (loading_) {
-    respond(RepositoryError(409, "a model is loading; retry when it is done"));
+    respond(OipError(409, "a model is loading; retry when it is done"));
     return;
   }
   if (loader_.joinable()) loader_.join();  // the previous load, finished
@@ -139,7 +129,7 @@ void OipRepositoryApi::Load(const std::string& name, const http::Responder& resp
       std::lock_guard done(loader_mutex_);
       loading_ = false;
     }
-    respond(loaded.ok() ? http::ContentResponse("{}", kJson) : RepositoryError(loaded));
+    respond(loaded.ok() ? http::ContentResponse("{}", kJson) : OipError(loaded));
   });
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "server/access_log.h"
+#include "server/oip/oip_errors.h"
 #include "server/oip/oip_model.h"
 #include "server/oip/oip_path.h"
 #include "server/status_mapping.h"
@@ -17,21 +18,7 @@ using http::beast_http::field;
 using http::beast_http::verb;
 using nlohmann::json;
 
-constexpr char kJson[] = "application/json";
-
-std::string Dump(const json& value) {
-  // Messages may quote a client's bytes (a %-decoded model name): never throw on bad UTF-8.
-  return value.dump(-1, ' ', false, json::error_handler_t::replace);
-}
-
-// The protocol's error body: {"error": "<message>"}.
-http::Response OipError(unsigned http_status, std::string_view message) {
-  return http::ContentResponse(Dump({{"error", message}}), kJson, http_status);
-}
-
-http::Response OipError(const Status& status) {
-  return OipError(HttpStatusFor(status, Rejection::kNone), status.message());
-}
+constexpr const char* kJson = kJsonType;
 
 std::string CodeName(const Status& status) { return GrpcCodeName(ToGrpcCode(status.code())); }
 
