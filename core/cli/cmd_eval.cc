@@ -46,7 +46,7 @@ Runner AddEvalCommand(CLI::App& app) {
       nlohmann::json numbers = EvalReportToJson(*report);
       numbers["data"] = options.data.data_root;
       numbers["split"] = options.data.split;
-      const Status st = UpdateManifestEval(args->model, numbers);
+      const Status st = UpdateManifestField(args->model, "eval", numbers);
       if (!st.ok()) return Fail(st.message());
     }
     if (!args->plots.empty()) {

@@ -1,5 +1,6 @@
 // tod synth --out DIR --train N --test M --seed S [--width 2048 --height 1024]
 //           [--obstacles N] [--size-m MIN MAX] [--distance-m MIN MAX]
+//           [--horizon-frac F] [--camera-height-m H] [--focal-frac F] [--camera-jitter J]
 #include <iostream>
 #include <optional>
 #include <tuple>
@@ -17,6 +18,7 @@ Runner AddSynthCommand(CLI::App& app) {
     std::uint64_t seed = 1;
     std::optional<int> obstacles;
     std::optional<std::pair<double, double>> size_m, distance_m;
+    SynthParams camera;  // its camera fields only
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd =
@@ -35,8 +37,26 @@ Runner AddSynthCommand(CLI::App& app) {
   cmd->add_option("--distance-m", args->distance_m,
                   "obstacle distance range MIN MAX, metres (5 60)")
       ->check(CLI::Range(1.0, 200.0));
+  // Other cameras (issue 48): the horizon's row, the mounting height and the lens; each frame's
+  // true camera is written beside its labels (<stem>_camera.json).
+  cmd->add_option("--horizon-frac", args->camera.horizon_frac,
+                  "horizon row as a share of the height (0.40)")
+      ->check(CLI::Range(-0.5, 1.0));
+  cmd->add_option("--camera-height-m", args->camera.camera_height_m,
+                  "camera height above the road, metres (1.4)")
+      ->check(CLI::Range(0.3, 5.0));
+  cmd->add_option("--focal-frac", args->camera.focal_frac,
+                  "focal length as a share of the width (1.1)")
+      ->check(CLI::Range(0.2, 5.0));
+  cmd->add_option("--camera-jitter", args->camera.camera_jitter,
+                  "per-frame variation of the camera, relative (0.08)")
+      ->check(CLI::Range(0.0, 0.5));
   return [args] {
     SynthParams params;
+    params.horizon_frac = args->camera.horizon_frac;
+    params.camera_height_m = args->camera.camera_height_m;
+    params.focal_frac = args->camera.focal_frac;
+    params.camera_jitter = args->camera.camera_jitter;
     params.width = args->width;
     params.height = args->height;
     if (args->obstacles) params.min_obstacles = params.max_obstacles = *args->obstacles;

@@ -127,7 +127,7 @@ int EvaluateIntoManifest(const ModelBundle& bundle, const TrainOptions& trained,
   std::cout << FormatEvalTables(*report);
   nlohmann::json numbers = EvalReportToJson(*report);
   numbers["split"] = eval.data.split;
-  const Status st = UpdateManifestEval(args.out, numbers);
+  const Status st = UpdateManifestField(args.out, "eval", numbers);
   return st.ok() ? 0 : Fail(st.message());
 }
 

@@ -16,6 +16,7 @@ Runner AddEvalCommand(CLI::App& app);
 Runner AddAnalyseCommand(CLI::App& app);
 Runner AddBenchCommand(CLI::App& app);
 Runner AddCvCommand(CLI::App& app);
+Runner AddHorizonCommand(CLI::App& app);
 
 // Prints "tod: <message>" to stderr and returns 1.
 int Fail(const std::string& message);

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   add(tod::cli::AddAnalyseCommand);
   add(tod::cli::AddBenchCommand);
   add(tod::cli::AddCvCommand);
+  add(tod::cli::AddHorizonCommand);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

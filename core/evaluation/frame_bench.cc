@@ -154,8 +154,8 @@ std::vector<std::string> StageOrder(const std::vector<FrameBenchRecord>& records
 
 const std::vector<std::string>& BenchStageNames() {
   static const std::vector<std::string> kNames = {
-      "decode",   "edges",      "superpixels", "occlusion",  "proposals",
-      "features", "regression", "map",         "encode_map", "total"};
+      "decode",     "calibration", "edges", "superpixels", "occlusion", "proposals",
+      "features",   "regression",  "map",   "encode_map",  "total"};
   return kNames;
 }
 

@@ -86,7 +86,8 @@ Result<std::vector<ScoredBox>> AddSingleStrideVariants(const ModelBundle& bundle
   ProposalSet op = MergeRegionBoxes(plain_regions, bundle.params.region_merge_iou);
   out.ranked["OAOCC+OLP@4"] = RankedOnCommonScale(op);
   const RegressedProposals op_regressed =
-      RegressProposals(bundle, s.image, trace.oaocc, geo.regions, std::move(op));
+      RegressProposals(bundle, s.image, trace.oaocc, geo.regions, std::move(op), nullptr,
+                       {.horizon_shift = geo.horizon.shift});
   return ScoredWith(op_regressed, op_regressed.ordr);
 }
 
@@ -140,11 +141,12 @@ Status MeasureReportedObstacles(const Sample& s, const FrameTrace& trace,
 
 Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sample& sample) {
   const ModelBundle& bundle = detector.bundle();
-  const FrameGeometry geo = GeometryForFrame(bundle, sample.image.cols, sample.image.rows);
   FrameEvaluation out;
-  if (Status st = AddPlainEdgeBaselines(bundle, sample, geo, out); !st.ok()) return st;
   Result<DetectorPath> path = RunDetectorPath(detector, sample, out);
   if (!path.ok()) return path.status();
+  // The baselines stand on the geometry the detector used (calibrated like it).
+  if (Status st = AddPlainEdgeBaselines(bundle, sample, path->trace.geometry, out); !st.ok())
+    return st;
   out.stage_times = path->detection.timings;
   out.total_ms = 0;
   for (const auto& [stage, ms] : out.stage_times) out.total_ms += ms;

@@ -14,6 +14,7 @@
 #include "core/base/stage_timer.h"
 #include "core/base/status.h"
 #include "core/base/types.h"
+#include "core/calibration/horizon_choice.h"
 
 namespace tod {
 
@@ -55,6 +56,12 @@ struct DetectOptions {
   // it. A stage itself is never interrupted, so the hook only has to be cheap and thread-safe.
   // Empty: run to the end.
   std::function<Status()> cancelled;
+  // Self-calibration (issue 48): the frame's horizon is estimated and the bundle's regions,
+  // size filter and ground-plane features are moved to it (Detection::horizon says what was
+  // used). With `camera`, the camera's median over the frames it sent is used instead of the
+  // frame's own estimate, and this frame's estimate joins it.
+  bool calibrate = true;
+  std::shared_ptr<CameraTrack> camera;
 };
 
 struct Proposal {
@@ -85,6 +92,8 @@ struct Detection {
   // Stages the frame budget cut short ("proposals", "regression"); empty: the full result.
   std::vector<std::string> degraded_stages;
   bool degraded() const { return !degraded_stages.empty(); }
+  // The horizon the geometry stood on and where it came from (bundle, frame, camera).
+  HorizonUse horizon;
 };
 
 struct ModelInfo {

@@ -22,15 +22,19 @@ FrameMapping MappingForFrame(int train_width, int train_height, int width, int h
   return m;
 }
 
-FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height) {
+FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height,
+                               double horizon_shift) {
   FrameGeometry g;
   g.size_filter = bundle.size_filter;
+  g.horizon.row = BundleHorizonRow(bundle, width, height);
+  g.horizon.bundle_row = g.horizon.row;
   const MultilayerRegions& trained = bundle.regions;
-  if (width == trained.image_width && height == trained.image_height) {
+  if (width == trained.image_width && height == trained.image_height && horizon_shift == 0) {
     g.regions = trained;
     return g;
   }
-  const FrameMapping m = MappingForFrame(trained.image_width, trained.image_height, width, height);
+  FrameMapping m = MappingForFrame(trained.image_width, trained.image_height, width, height);
+  m.dy += horizon_shift;
   g.regions.image_width = width;
   g.regions.image_height = height;
   for (const Box& r : trained.layers)
@@ -57,13 +61,35 @@ double MappedRow(const ModelBundle& bundle, int width, int height, double row) {
 
 }  // namespace
 
-BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height) {
+std::optional<double> BundleHorizonRow(const ModelBundle& bundle, int width, int height) {
+  if (!bundle.horizon_reference) return std::nullopt;
+  return MappedRow(bundle, width, height, bundle.horizon_reference->row);
+}
+
+FrameGeometry CalibratedGeometryForFrame(const ModelBundle& bundle, const cv::Mat3b& frame,
+                                         const GeometryRequest& request) {
+  if (!request.calibrate) {
+    FrameGeometry g = GeometryForFrame(bundle, frame.cols, frame.rows);
+    g.horizon.fallback = "calibration off";
+    return g;
+  }
+  const std::optional<double> bundle_row = BundleHorizonRow(bundle, frame.cols, frame.rows);
+  // A bundle without a reference cannot be moved: the frame is not even looked at.
+  const HorizonEstimate estimate = bundle_row ? EstimateHorizon(frame) : HorizonEstimate{};
+  HorizonUse use = ChooseHorizon(bundle_row, frame.rows, estimate, request.camera);
+  FrameGeometry g = GeometryForFrame(bundle, frame.cols, frame.rows, use.shift);
+  g.horizon = std::move(use);
+  return g;
+}
+
+BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height,
+                                         double horizon_shift) {
   BoxFeatureOptions options;
   options.vertical_edges = bundle.params.vertical_edge_feature;
   options.road_surround = bundle.params.road_surround_feature;
   const GroundPlaneFeatureParams& params = bundle.params.box_features;
   if (params.ground_plane_size)
-    options.horizon_y = MappedRow(bundle, width, height, params.horizon_y);
+    options.horizon_y = MappedRow(bundle, width, height, params.horizon_y) + horizon_shift;
   return options;
 }
 

@@ -8,8 +8,15 @@
 // the image centre times s. So a 2048 x 1024 bundle on a 1920 x 1080 frame uses s = 0.9375 and
 // shifts rows by +60 px (the taller frame shows more above and below); on 1280 x 720, s = 0.625.
 // Regions are clipped to the frame.
+//
+// A camera mounted higher or lower, or pitched, puts the road elsewhere: self-calibration
+// (core/calibration, issue 48) estimates the frame's horizon and moves every row the bundle
+// learned by the horizon's offset from the bundle's reference (FrameGeometry::horizon).
 #pragma once
 
+#include <opencv2/core.hpp>
+
+#include "core/calibration/horizon_choice.h"
 #include "core/features/box_features.h"
 #include "core/pipeline/model_bundle.h"
 
@@ -26,15 +33,31 @@ struct FrameMapping {
 // The mapping from the training frame (train_w x train_h) to a frame of width x height.
 FrameMapping MappingForFrame(int train_width, int train_height, int width, int height);
 
-// Regions and size filter of a bundle for frames of a given size.
+// Regions and size filter of a bundle for frames of a given size, every row moved down by
+// horizon_shift rows (the calibrated horizon's offset, HorizonUse::shift).
 struct FrameGeometry {
   MultilayerRegions regions;
   SizeFilter size_filter;
+  HorizonUse horizon;  // where the rows stand and why; horizon.shift moved them
 };
-FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height);
+FrameGeometry GeometryForFrame(const ModelBundle& bundle, int width, int height,
+                               double horizon_shift = 0);
+
+// How a frame's geometry is chosen: with `calibrate`, from the frame's horizon estimate (and the
+// camera's, when `camera` is not null), else the bundle's.
+struct GeometryRequest {
+  bool calibrate = true;
+  CameraTrack* camera = nullptr;
+};
+FrameGeometry CalibratedGeometryForFrame(const ModelBundle& bundle, const cv::Mat3b& frame,
+                                         const GeometryRequest& request);
+
+// The bundle's horizon reference on a frame of width x height; none without one.
+std::optional<double> BundleHorizonRow(const ModelBundle& bundle, int width, int height);
 
 // The proposal features' options of a bundle for frames of a given size: the ground-plane
 // horizon (PipelineParams::box_features) mapped like the regions' rows.
-BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height);
+BoxFeatureOptions FeatureOptionsForFrame(const ModelBundle& bundle, int width, int height,
+                                         double horizon_shift = 0);
 
 }  // namespace tod

@@ -109,6 +109,7 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
   manifest["params"] = ToJson(bundle.params);
   manifest["regions"] = bundle.regions.ToJson();
   manifest["size_filter"] = bundle.size_filter.ToJson();
+  if (bundle.horizon_reference) manifest["horizon_reference"] = bundle.horizon_reference->ToJson();
   manifest["training"] = bundle.training;
   manifest["eval"] = bundle.eval;
   manifest["files"] = files;
@@ -212,6 +213,12 @@ Status ReadManifestFields(const BundleFiles& files, ModelBundle& bundle) {
     if (!regions.ok()) return Status::InvalidArgument(where + ": " + regions.status().message());
     bundle.regions = *regions;
     bundle.size_filter = SizeFilter::FromJson(manifest.at("size_filter"));
+    if (manifest.contains("horizon_reference")) {
+      auto reference = HorizonReference::FromJson(manifest["horizon_reference"]);
+      if (!reference.ok())
+        return Status::InvalidArgument(where + ": " + reference.status().message());
+      bundle.horizon_reference = *reference;
+    }
     bundle.training = manifest.value("training", nlohmann::json());
     bundle.eval = manifest.value("eval", nlohmann::json());
   } catch (const nlohmann::json::exception& e) {
@@ -295,7 +302,8 @@ Result<ModelBundle> LoadModelBundle(const std::string& dir) {
   return bundle;
 }
 
-Status UpdateManifestEval(const std::string& dir, const nlohmann::json& eval) {
+Status UpdateManifestField(const std::string& dir, const std::string& field,
+                           const nlohmann::json& value) {
   const fs::path path = fs::path(dir) / kManifest;
   auto text = ReadFile(path);
   if (!text.ok()) return text.status();
@@ -305,7 +313,7 @@ Status UpdateManifestEval(const std::string& dir, const nlohmann::json& eval) {
   } catch (const nlohmann::json::exception& e) {
     return Status::DataLoss(path.string() + ": not valid JSON");
   }
-  manifest["eval"] = eval;
+  manifest[field] = value;
   return WriteFileAtomically(path.string(), manifest.dump(2) + "\n");
 }
 

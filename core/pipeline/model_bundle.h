@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/base/status.h"
+#include "core/calibration/horizon_reference.h"
 #include "core/edges/edge_source.h"
 #include "core/edges/occlusion_classifier.h"
 #include "core/forest/random_forest.h"
@@ -24,6 +25,9 @@ struct ModelBundle {
   PipelineParams params;
   MultilayerRegions regions;
   SizeFilter size_filter;
+  // The training camera's horizon as EstimateHorizon sees it; none in bundles made before
+  // self-calibration (their frames keep the bundle's geometry, and say so).
+  std::optional<HorizonReference> horizon_reference;
   EdgeKind edge_kind = EdgeKind::kPixelForest;
   std::shared_ptr<const EdgeSource> edges;
   std::string sed_model_file;  // for kSed: file name inside the bundle
@@ -44,8 +48,10 @@ Status SaveModelBundle(const ModelBundle& bundle, const std::string& dir,
 
 Result<ModelBundle> LoadModelBundle(const std::string& dir);
 
-// Rewrites only manifest.json (e.g. to add eval numbers), atomically via a temporary file.
-Status UpdateManifestEval(const std::string& dir, const nlohmann::json& eval);
+// Rewrites one top-level field of manifest.json ("eval" numbers, "horizon_reference"),
+// atomically via a temporary file.
+Status UpdateManifestField(const std::string& dir, const std::string& field,
+                           const nlohmann::json& value);
 
 // Current UTC time as ISO 8601.
 std::string NowIso8601();

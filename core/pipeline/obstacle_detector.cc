@@ -159,7 +159,9 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   StageTimer timer(options.cancelled);  // asks options.cancelled at every stage boundary
   const FrameBudget budget(std::chrono::steady_clock::now(), options.budget_ms);
   const int threads = std::max(1, options.threads);
-  frame.geometry = GeometryForFrame(bundle_, bgr.cols, bgr.rows);
+  frame.geometry = CalibratedGeometryForFrame(
+      bundle_, bgr, {.calibrate = options.calibrate, .camera = options.camera.get()});
+  timer.Mark("calibration");
   const MultilayerRegions& regions = frame.geometry.regions;
   Result<OcclusionEdges> computed =
       ComputeOcclusionEdges(bgr, regions, *bundle_.edges, &bundle_.occlusion, bundle_.params,
@@ -189,8 +191,9 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
       // The regions' own boxes are freed with the merge unless the caller keeps them.
       if (trace == nullptr) frame.regions = {};
     } else {
-      colour_tables = BuildFrameColourTables(bgr, oaocc.r1,
-                                             FeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows));
+      colour_tables = BuildFrameColourTables(
+          bgr, oaocc.r1,
+          FeatureOptionsForFrame(bundle_, bgr.cols, bgr.rows, frame.geometry.horizon.shift));
     }
     return Status::Ok();
   };
@@ -199,10 +202,13 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   timer.Mark("proposals");
   if (!timer.stopped().ok()) return timer.stopped();
   Detection out;
+  out.horizon = frame.geometry.horizon;
   if (oaocc.occlusion_cut_short) out.degraded_stages.push_back("occlusion");
   if (!proposals.truncated_regions.empty()) out.degraded_stages.push_back("proposals");
   frame.regressed = RegressProposals(bundle_, bgr, oaocc, regions, std::move(proposals), &timer,
-                                     {.deadline = budget.RegressionDeadline(), .threads = threads},
+                                     {.deadline = budget.RegressionDeadline(),
+                                      .threads = threads,
+                                      .horizon_shift = frame.geometry.horizon.shift},
                                      std::move(colour_tables));
   if (!timer.stopped().ok()) return timer.stopped();
   if (frame.regressed.truncated) out.degraded_stages.push_back("regression");

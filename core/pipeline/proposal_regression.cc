@@ -42,7 +42,7 @@ RegressedProposals RegressProposals(const ModelBundle& bundle, const cv::Mat3b& 
   using Clock = std::chrono::steady_clock;
   RegressedProposals out;
   const std::size_t n = proposals.boxes.size();
-  const BoxFeatureOptions feature_options = FeatureOptionsForFrame(bundle, image.cols, image.rows);
+  const BoxFeatureOptions feature_options = FeatureOptionsForFrame(bundle, image.cols, image.rows, limits.horizon_shift);
   cv::Mat1f features(static_cast<int>(n), NumBoxFeatures(feature_options), 0.f);
   out.ordr.assign(n, 0.f);
   const ProposalFeatureComputer computer(image, oaocc, regions, proposals, feature_options,

@@ -27,6 +27,9 @@ struct RegressionLimits {
   // once this has passed (frame_budget.h). No deadline: all are.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
   int threads = 1;  // threads sharing each chunk
+  // The calibrated horizon's offset on this frame (FrameGeometry::horizon.shift): the
+  // ground-plane features' horizon moves with the regions.
+  double horizon_shift = 0;
 };
 
 // ORDR and OBDR scores of every proposal (features computed here); OBDR only on the boxes that

@@ -6,11 +6,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <system_error>
 #include <utility>
 
+#include "core/base/atomic_file.h"
 #include "core/synth/synth_canvas.h"
 #include "core/synth/synth_effects.h"
 #include "core/synth/synth_obstacles.h"
@@ -163,6 +166,37 @@ std::uint64_t SynthFrameSeed(std::uint64_t dataset_seed, int frame_index) {
   return synth::MixSeed(dataset_seed ^ synth::MixSeed(static_cast<std::uint64_t>(frame_index) + 1));
 }
 
+std::string SynthCameraJson(const SynthCameraInfo& camera) {
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "{\"focal_px\": %.3f, \"center_x\": %.3f, \"horizon_row\": %.3f, "
+                "\"camera_height_m\": %.4f}\n",
+                camera.focal_px, camera.center_x, camera.horizon_row, camera.camera_height_m);
+  return text;
+}
+
+std::optional<SynthCameraInfo> ReadSynthCamera(const std::string& image_path) {
+  const std::string image_suffix = "_leftImg8bit.png";
+  const std::size_t dir = image_path.rfind("leftImg8bit/");
+  if (dir == std::string::npos || image_path.size() < image_suffix.size() ||
+      image_path.compare(image_path.size() - image_suffix.size(), image_suffix.size(),
+                         image_suffix) != 0)
+    return std::nullopt;
+  std::string path = image_path.substr(0, image_path.size() - image_suffix.size());
+  path.replace(dir, std::string("leftImg8bit").size(), "gtCoarse");
+  std::ifstream in(path + kSynthCameraSuffix);
+  if (!in) return std::nullopt;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object() || !j.contains("horizon_row") || !j["horizon_row"].is_number())
+    return std::nullopt;
+  SynthCameraInfo camera;
+  camera.focal_px = j.value("focal_px", 0.0);
+  camera.center_x = j.value("center_x", 0.0);
+  camera.horizon_row = j["horizon_row"].get<double>();
+  camera.camera_height_m = j.value("camera_height_m", 0.0);
+  return camera;
+}
+
 Status WriteSynthDataset(const std::string& out_dir, const SynthParams& params, int train_count,
                          int test_count, std::uint64_t seed,
                          const std::function<void(int done, int total)>& progress) {
@@ -198,6 +232,9 @@ Status WriteSynthDataset(const std::string& out_dir, const SynthParams& params, 
       Status s = WritePng(image_dir / (stem + "_leftImg8bit.png"), frame.sample.image);
       if (s.ok()) s = WritePng(gt_dir / (stem + "_gtCoarse_labelIds.png"), frame.label_ids);
       if (s.ok()) s = WritePng(gt_dir / (stem + "_gtCoarse_instanceIds.png"), frame.instance_ids);
+      if (s.ok())
+        s = WriteFileAtomically((gt_dir / (stem + kSynthCameraSuffix)).string(),
+                                SynthCameraJson(frame.camera));
       if (!s.ok()) return s;
       ++done;
       if (progress) progress(done, total);

@@ -75,6 +75,15 @@ struct SynthCameraInfo {
   double camera_height_m = 0;
 };
 
+// WriteSynthDataset writes each frame's camera beside its labels, as
+// gtCoarse/<split>/<scene>/<stem>_camera.json: the true horizon row the calibration is measured
+// against (tod horizon).
+inline constexpr const char* kSynthCameraSuffix = "_camera.json";
+std::string SynthCameraJson(const SynthCameraInfo& camera);
+// The camera written beside a synthetic frame whose image is at `image_path` (its
+// leftImg8bit/.../<stem>_leftImg8bit.png); none when the frame has no such file.
+std::optional<SynthCameraInfo> ReadSynthCamera(const std::string& image_path);
+
 // A generated frame with the raw LAF annotation images it is written as.
 struct SynthFrame {
   Sample sample;

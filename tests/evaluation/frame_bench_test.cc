@@ -54,7 +54,7 @@ TEST(FrameBenchTest, ListsImagesRecursivelySortedWhateverTheExtensionCase) {
 }
 
 TEST(FrameBenchTest, StageNamesAreTheContract) {
-  const std::vector<std::string> expected = {"decode",     "edges",    "superpixels", "occlusion",
+  const std::vector<std::string> expected = {"decode",     "calibration", "edges",    "superpixels", "occlusion",
                                              "proposals",  "features", "regression",  "map",
                                              "encode_map", "total"};
   EXPECT_EQ(BenchStageNames(), expected);

@@ -13,7 +13,7 @@ namespace tod {
 namespace {
 
 // The boundaries Detect asks at, in order (the bundle has an occlusion classifier).
-const std::vector<std::string> kBoundaries = {"edges",     "superpixels", "occlusion",
+const std::vector<std::string> kBoundaries = {"calibration", "edges",     "superpixels", "occlusion",
                                               "proposals", "features",    "regression"};
 
 class DetectCancellationTest : public TinyDetectorTest {

@@ -36,7 +36,7 @@ TEST_F(FrameTraceTest, AskingForTheTraceChangesNothingInTheDetection) {
   ASSERT_EQ(plain->obstacles.size(), traced->obstacles.size());
   std::vector<std::string> stages;
   for (const auto& [stage, ms] : traced->timings) stages.push_back(stage);
-  EXPECT_EQ(stages, (std::vector<std::string>{"edges", "superpixels", "occlusion", "proposals",
+  EXPECT_EQ(stages, (std::vector<std::string>{"calibration", "edges", "superpixels", "occlusion", "proposals",
                                               "features", "regression", "probability_map"}));
 }
 

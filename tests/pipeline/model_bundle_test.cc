@@ -188,7 +188,7 @@ TEST_F(ModelBundleTest, MissingDirectory) {
 
 TEST_F(ModelBundleTest, EvalNumbersAreAddedToTheManifest) {
   ASSERT_TRUE(SaveModelBundle(SmallBundle(1), Path()).ok());
-  ASSERT_TRUE(UpdateManifestEval(Path(), {{"frames", 3}}).ok());
+  ASSERT_TRUE(UpdateManifestField(Path(), "eval", {{"frames", 3}}).ok());
   auto loaded = LoadModelBundle(Path());
   ASSERT_TRUE(loaded.ok());
   EXPECT_EQ(loaded->eval["frames"], 3);

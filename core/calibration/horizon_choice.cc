@@ -1,0 +1,50 @@
+#include "core/calibration/horizon_choice.h"
+
+#include <cmath>
+
+namespace tod {
+
+const char* HorizonSourceName(HorizonSource source) {
+  switch (source) {
+    case HorizonSource::kFrame:
+      return "frame";
+    case HorizonSource::kCamera:
+      return "camera";
+    case HorizonSource::kBundle:
+      break;
+  }
+  return "bundle";
+}
+
+HorizonUse ChooseHorizon(std::optional<double> bundle_row, int frame_height,
+                         const HorizonEstimate& frame, CameraTrack* camera,
+                         const HorizonChoiceParams& params) {
+  HorizonUse use;
+  use.bundle_row = bundle_row;
+  use.row = bundle_row;
+  if (frame.found) use.frame_estimate = frame.row;
+  if (!bundle_row) {
+    use.fallback = "the bundle has no horizon reference (tod calibrate adds one)";
+    return use;
+  }
+  std::optional<double> estimate = use.frame_estimate;
+  if (camera != nullptr) {
+    const CameraTrack::View view = camera->Observe(use.frame_estimate);
+    if (view.row) {
+      use.source = HorizonSource::kCamera;
+      use.camera_frames = view.frames;
+      estimate = view.row;
+    }
+  }
+  if (!estimate) {
+    use.fallback = frame.reason.empty() ? "no horizon estimate" : frame.reason;
+    return use;
+  }
+  if (use.source != HorizonSource::kCamera) use.source = HorizonSource::kFrame;
+  use.row = estimate;
+  const double deadband = params.deadband_rows_at_1024 * frame_height / 1024.0;
+  if (std::abs(*estimate - *bundle_row) > deadband) use.shift = *estimate - *bundle_row;
+  return use;
+}
+
+}  // namespace tod
