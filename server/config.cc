@@ -53,6 +53,11 @@ const std::vector<SettingSpec>& SettingSpecs() {
        "Largest encoded image accepted, bytes (default 16 MiB)"},
       {"max_image_pixels", "max-image-pixels", "TOD_MAX_IMAGE_PIXELS",
        "Largest image accepted, width*height (default 4e6, at most 1e8)"},
+      {"max_cameras", "max-cameras", "TOD_MAX_CAMERAS",
+       "Cameras (camera_id) whose horizon estimate is kept; the least recently seen is "
+       "forgotten to admit a new one (default 1024)"},
+      {"camera_idle_s", "camera-idle", "TOD_CAMERA_IDLE",
+       "Seconds a camera that sends no frame keeps its horizon estimate (default 600)"},
       {"drain_timeout_s", "drain-timeout", "TOD_DRAIN_TIMEOUT",
        "Seconds SIGTERM waits for queued and running work (default 20)"},
       {"retry_after_s", "retry-after", "TOD_RETRY_AFTER",
@@ -118,6 +123,10 @@ Status ApplySetting(const std::string& key, const std::string& value, const std:
     return ParseNumber(value, what, &config->max_image_bytes);
   } else if (key == "max_image_pixels") {
     return ParseNumber(value, what, &config->max_image_pixels);
+  } else if (key == "max_cameras") {
+    return ParseNumber(value, what, &config->max_cameras);
+  } else if (key == "camera_idle_s") {
+    return ParseNumber(value, what, &config->camera_idle_s);
   } else if (key == "drain_timeout_s") {
     return ParseNumber(value, what, &config->drain_timeout_s);
   } else if (key == "retry_after_s") {
@@ -230,6 +239,12 @@ Status ValidateServing(const ServerConfig& config) {
     return Status::InvalidArgument("frame_budget_ms: must be in 0..600000 (0: no budget)");
   }
   if (config.queue < 0) return Status::InvalidArgument("queue: must be >= 0");
+  if (config.max_cameras < 1 || config.max_cameras > 1'000'000) {
+    return Status::InvalidArgument("max_cameras: must be in 1..1000000");
+  }
+  if (!(config.camera_idle_s >= 1 && config.camera_idle_s <= 7 * 86400)) {
+    return Status::InvalidArgument("camera_idle_s: must be in 1..604800 seconds");
+  }
   return Status::Ok();
 }
 
@@ -340,6 +355,8 @@ nlohmann::json ServerConfigToJson(const ServerConfig& config) {
           {"queue", config.queue},
           {"max_image_bytes", config.max_image_bytes},
           {"max_image_pixels", config.max_image_pixels},
+          {"max_cameras", config.max_cameras},
+          {"camera_idle_s", config.camera_idle_s},
           {"drain_timeout_s", config.drain_timeout_s},
           {"retry_after_s", config.retry_after_s},
           {"http_threads", config.http_threads},

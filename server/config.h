@@ -35,6 +35,9 @@ struct ServerConfig {
   // The shipped model's camera frames are 2048 x 1024 (2.1 MP); 4 MP leaves headroom while a
   // bigger frame would only cost seconds of CPU and hundreds of MB per request.
   long long max_image_pixels = 4'000'000;
+  // Cameras (camera_id) whose horizon estimate is kept, and how long an unseen one is kept.
+  int max_cameras = 1024;
+  double camera_idle_s = 600;
   double drain_timeout_s = 20;  // SIGTERM: time allowed for queued + running work
   int retry_after_s = 1;        // Retry-After on 503 (queue full)
   int http_threads = 2;         // REST I/O threads (connections are asynchronous)

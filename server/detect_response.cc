@@ -22,6 +22,7 @@ RequestOptions OptionsFromProto(const tod::v1::DetectOptions& options) {
     out.detect.min_obstacle_score = options.min_obstacle_score();
   }
   if (options.has_budget_ms()) out.detect.budget_ms = options.budget_ms();
+  if (options.has_calibrate()) out.detect.calibrate = options.calibrate();
   out.detect.map_kind = options.map_kind() == tod::v1::MAP_KIND_CALIBRATED ? MapKind::kCalibrated
                                                                            : MapKind::kNormalized;
   out.encode_map_png = options.map_format() != tod::v1::MAP_FORMAT_NONE;
@@ -68,6 +69,21 @@ void FillDetectResponse(const InferenceResult& result, const std::string& frame_
   response->set_total_ms(result.total_ms);
   response->set_degraded(detection.degraded());
   for (const std::string& stage : detection.degraded_stages) response->add_degraded_stages(stage);
+  FillGeometry(detection, response->mutable_geometry());
+}
+
+void FillGeometry(const Detection& detection, tod::v1::Geometry* geometry) {
+  const HorizonUse& h = detection.horizon;
+  geometry->set_source(HorizonSourceName(h.source));
+  if (h.row) geometry->set_horizon_row(*h.row);
+  if (h.bundle_row) geometry->set_bundle_horizon_row(*h.bundle_row);
+  if (h.frame_estimate) geometry->set_frame_horizon_row(*h.frame_estimate);
+  geometry->set_camera_frames(h.camera_frames);
+  geometry->set_shift_rows(h.shift);
+  const Box& r = detection.road_region;
+  tod::v1::Box* road = geometry->mutable_road_region();
+  road->set_x(r.x), road->set_y(r.y), road->set_w(r.w), road->set_h(r.h);
+  geometry->set_fallback(h.fallback);
 }
 
 void FillModelInfo(const LoadedModel& model, tod::v1::ModelInfo* info) {

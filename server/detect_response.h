@@ -23,6 +23,8 @@ RequestOptions OptionsFromProto(const tod::v1::DetectOptions& options);
 void FillDetectResponse(const InferenceResult& result, const std::string& frame_id,
                         tod::v1::DetectResponse* response);
 
+// The geometry the detection stood on (DetectResponse.geometry).
+void FillGeometry(const Detection& detection, tod::v1::Geometry* geometry);
 void FillModelInfo(const LoadedModel& model, tod::v1::ModelInfo* info);
 
 }  // namespace tod::server

@@ -33,7 +33,7 @@ class DetectStreamReactor final
     // Advance before submitting: the completion may run (and start the next read) at once.
     const long long index = frame_index_++;
     service_.SubmitFrame(
-        context_, request_, std::to_string(index), cancellation_, &response_,
+        context_, request_, std::to_string(index), cancellation_, camera_, &response_,
         [this, index](grpc::Status status) {
           if (!status.ok()) {
             Finish(grpc::Status(status.error_code(), std::string("frame ") + std::to_string(index) +
@@ -61,6 +61,9 @@ class DetectStreamReactor final
   grpc::ByteBuffer response_;
   long long frame_index_ = 0;
   const std::shared_ptr<Cancellation> cancellation_ = std::make_shared<Cancellation>();
+  // A stream is one camera: its frames that name no camera_id share this horizon estimate,
+  // which ends with the stream (fixed size, so a stream costs the same however long it runs).
+  const std::shared_ptr<CameraTrack> camera_ = std::make_shared<CameraTrack>();
 };
 
 // A stream refused before its first read (no valid token).
@@ -92,6 +95,7 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
                                            const grpc::ByteBuffer& request_bytes,
                                            const std::string& default_frame_id,
                                            std::shared_ptr<Cancellation> cancellation,
+                                           std::shared_ptr<CameraTrack> stream_camera,
                                            grpc::ByteBuffer* response,
                                            std::function<void(grpc::Status)> done) {
   AccessRecord access;
@@ -116,6 +120,8 @@ void ObstacleDiscoveryService::SubmitFrame(grpc::CallbackServerContext* context,
   inference.encode_map_png = options.encode_map_png;
   inference.deadline = SteadyDeadline(*context);
   inference.cancellation = std::move(cancellation);
+  inference.camera_id = request->camera_id();
+  inference.stream_camera = std::move(stream_camera);
   access.frame = !request->frame_id().empty() ? request->frame_id()
                  : !default_frame_id.empty()  ? default_frame_id
                                               : access.id;
@@ -169,7 +175,7 @@ grpc::ServerUnaryReactor* ObstacleDiscoveryService::Detect(grpc::CallbackServerC
   }
   auto cancellation = std::make_shared<Cancellation>();
   auto* reactor = new CancellableUnaryReactor(*context, cancellation);  // deletes itself in OnDone
-  SubmitFrame(context, *request, "", std::move(cancellation), response,
+  SubmitFrame(context, *request, "", std::move(cancellation), nullptr, response,
               [reactor](grpc::Status status) { reactor->Finish(status); });
   return reactor;
 }

@@ -47,10 +47,12 @@ class ObstacleDiscoveryService final : public RawObstacleDiscoveryService {
 
   // Parses and submits one frame; `done` gets the status and, when OK, the serialised
   // DetectResponse in `response`. `done` may run inline or on a worker thread. The call's
-  // reactor cancels `cancellation` when gRPC cancels the call.
+  // reactor cancels `cancellation` when gRPC cancels the call. `stream_camera`: the horizon
+  // track of the stream the frame came on (null for a unary call).
   void SubmitFrame(grpc::CallbackServerContext* context, const grpc::ByteBuffer& request,
                    const std::string& default_frame_id, std::shared_ptr<Cancellation> cancellation,
-                   grpc::ByteBuffer* response, std::function<void(grpc::Status)> done);
+                   std::shared_ptr<CameraTrack> stream_camera, grpc::ByteBuffer* response,
+                   std::function<void(grpc::Status)> done);
   std::string NextRequestId();
 
  private:

@@ -2,6 +2,7 @@
 
 #include <prometheus/text_serializer.h>
 
+#include "core/calibration/horizon_choice.h"
 #include "server/core/cancellation.h"
 
 namespace tod::server {
@@ -80,12 +81,32 @@ ServerMetrics::ServerMetrics()
       model_frames_(prometheus::BuildCounter()
                         .Name("tod_model_frames_total")
                         .Help("Frames detected, by the model that served them")
-                        .Register(*registry_)) {
+                        .Register(*registry_)),
+      geometry_(prometheus::BuildCounter()
+                    .Name("tod_geometry_total")
+                    .Help("Frames detected, by where their road geometry came from (bundle, "
+                          "frame, camera)")
+                    .Register(*registry_)),
+      geometry_fallbacks_(prometheus::BuildCounter()
+                              .Name("tod_geometry_fallbacks_total")
+                              .Help("Frames whose geometry could not be calibrated and fell "
+                                    "back to the bundle's")
+                              .Register(*registry_)
+                              .Add({})),
+      cameras_(prometheus::BuildGauge()
+                   .Name("tod_cameras_tracked")
+                   .Help("Cameras whose horizon estimate the server keeps (camera_id, streams "
+                         "not counted)")
+                   .Register(*registry_)
+                   .Add({})) {
   // Every reason from the start, so dashboards and alerts see 0 rather than no series.
   for (const CancelReason reason : kAllCancelReasons)
     cancelled_.Add({{"reason", CancelReasonName(reason)}});
   for (const char* stage : {"occlusion", "proposals", "regression"})
     degraded_.Add({{"stage", stage}});
+  for (const HorizonSource source :
+       {HorizonSource::kBundle, HorizonSource::kFrame, HorizonSource::kCamera})
+    geometry_.Add({{"source", HorizonSourceName(source)}});
 }
 
 void ServerMetrics::RecordRequest(const std::string& protocol, const std::string& code,
@@ -124,13 +145,19 @@ void ServerMetrics::OnCancelled(CancelReason reason) {
 }
 
 void ServerMetrics::OnDetected(const std::string& model, const StageTimes& timings,
-                               const std::vector<std::string>& degraded_stages) {
+                               const Detection& detection) {
   model_frames_.Add({{"model", model}}).Increment();
   for (const auto& [stage, ms] : timings) {
     stage_duration_.Add({{"stage", stage}}, LatencyBuckets()).Observe(ms / 1000.0);
   }
-  for (const std::string& stage : degraded_stages) degraded_.Add({{"stage", stage}}).Increment();
+  for (const std::string& stage : detection.degraded_stages) {
+    degraded_.Add({{"stage", stage}}).Increment();
+  }
+  geometry_.Add({{"source", HorizonSourceName(detection.horizon.source)}}).Increment();
+  if (!detection.horizon.fallback.empty()) geometry_fallbacks_.Increment();
 }
+
+void ServerMetrics::OnCameras(size_t cameras) { cameras_.Set(static_cast<double>(cameras)); }
 
 void ServerMetrics::SetModels(const std::vector<ModelSeries>& models) {
   // Only the models loaded now: drop the series of unloaded ones and of older generations.

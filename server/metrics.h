@@ -33,8 +33,11 @@ class ServerMetrics final : public EngineObserver {
   void OnFinished() override;
   void OnRejected(Rejection rejection) override;
   void OnCancelled(CancelReason reason) override;
+  // Also counts each frame's geometry source (tod_geometry_total{source}) and the frames whose
+  // geometry fell back to the bundle's (tod_geometry_fallbacks_total).
   void OnDetected(const std::string& model, const StageTimes& timings,
-                  const std::vector<std::string>& degraded_stages) override;
+                  const Detection& detection) override;
+  void OnCameras(size_t cameras) override;  // tod_cameras_tracked
 
   // One finished request. protocol: "grpc" | "http"; code: the gRPC code name ("OK", ...).
   void RecordRequest(const std::string& protocol, const std::string& code, double seconds);
@@ -74,7 +77,10 @@ class ServerMetrics final : public EngineObserver {
   prometheus::Family<prometheus::Counter>& reloads_;
   prometheus::Family<prometheus::Counter>& token_reloads_;
   prometheus::Family<prometheus::Counter>& model_frames_;
-  std::mutex model_mutex_;                     // guards model_series_
+  prometheus::Family<prometheus::Counter>& geometry_;
+  prometheus::Counter& geometry_fallbacks_;
+  prometheus::Gauge& cameras_;
+  std::mutex model_mutex_;                        // guards model_series_
   std::vector<prometheus::Gauge*> model_series_;  // the tod_model_info series (registry owns them)
 };
 

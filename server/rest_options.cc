@@ -90,6 +90,17 @@ Status ParseDetectQuery(const QueryParams& query, InferenceRequest* inference,
     inference->deadline =
         std::chrono::steady_clock::now() + std::chrono::milliseconds(**timeout_ms);
   }
+  if (const auto calibrate = query.find("calibrate"); calibrate != query.end()) {
+    if (calibrate->second != "true" && calibrate->second != "false") {
+      return Status::InvalidArgument("query parameter calibrate='" + calibrate->second +
+                                     "': expected true or false");
+    }
+    inference->options.calibrate = calibrate->second == "true";
+  }
+  // Bounded and checked by the engine at admission, as on gRPC (CheckCameraId).
+  if (const auto camera = query.find("camera_id"); camera != query.end()) {
+    inference->camera_id = camera->second;
+  }
   if (const auto id = query.find("frame_id"); id != query.end()) *frame_id = id->second;
   if (const auto model = query.find("model"); model != query.end()) {
     inference->model = model->second;

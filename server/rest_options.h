@@ -3,6 +3,8 @@
 //   map            png | none              timeout_ms          integer 0..3600000 (0: none)
 //   budget_ms      integer 1..600000 (lowers the server's frame budget)
 //   frame_id       text                    model               a loaded model's name
+//   camera_id      printable ASCII, at most 128 bytes (the camera whose horizon is kept)
+//   calibrate      true | false (self-calibration of the road geometry; default true)
 // A value out of range or not a number is an InvalidArgument naming the parameter; nothing can
 // overflow (numbers are parsed into wide types and checked before use). The bounds gRPC shares
 // (max_proposals, budget_ms) are the engine's: kMaxRequestProposals, kMaxRequestBudgetMs.

@@ -204,6 +204,8 @@ EngineConfig EngineConfigFrom(const ServerConfig& config) {
   engine.threads_per_request = config.threads_per_request;
   engine.frame_budget_ms = config.frame_budget_ms;
   engine.queue_capacity = config.queue;
+  engine.cameras.max_cameras = static_cast<size_t>(config.max_cameras);
+  engine.cameras.idle_seconds = config.camera_idle_s;
   engine.limits.max_bytes = config.max_image_bytes;
   engine.limits.max_pixels = config.max_image_pixels;
   return engine;

@@ -10,6 +10,21 @@ CameraTrack::View CameraTrack::Observe(std::optional<double> frame_row) {
   return {horizon_.Estimate(), horizon_.frames()};
 }
 
+Status CheckCameraId(std::string_view camera_id, const CameraRegistryParams& params) {
+  if (camera_id.size() > params.max_id_bytes) {
+    return Status::InvalidArgument("camera_id: " + std::to_string(camera_id.size()) +
+                                   " bytes is over the limit of " +
+                                   std::to_string(params.max_id_bytes));
+  }
+  const auto bad =
+      std::find_if(camera_id.begin(), camera_id.end(), [](char c) { return c <= ' ' || c > '~'; });
+  if (bad != camera_id.end()) {
+    return Status::InvalidArgument("camera_id: byte " + std::to_string(bad - camera_id.begin()) +
+                                   " is not printable ASCII (spaces are not allowed either)");
+  }
+  return Status::Ok();
+}
+
 void CameraRegistry::ForgetIdle(Clock::time_point now) {
   const auto idle = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(params_.idle_seconds));

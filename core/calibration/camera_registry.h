@@ -11,7 +11,9 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 
+#include "core/base/status.h"
 #include "core/calibration/camera_horizon.h"
 
 namespace tod {
@@ -19,7 +21,8 @@ namespace tod {
 // One camera's estimate, shared by the requests of that camera.
 class CameraTrack {
  public:
-  // Adds a frame's estimate when there is one, then returns the camera's median and its frames.
+  // Adds a frame's estimate when there is one, then returns the camera's median and its frames
+  // (in whatever unit the caller keeps: ChooseHorizon uses shares of the frame's height).
   struct View {
     std::optional<double> row;
     long long frames = 0;
@@ -36,6 +39,10 @@ struct CameraRegistryParams {
   double idle_seconds = 600;
   std::size_t max_id_bytes = 128;  // longer camera_id values are refused by the front ends
 };
+
+// OK when `camera_id` can name a camera: at most params.max_id_bytes of printable ASCII and no
+// spaces (it is logged and used as a map key); empty is fine (no camera). InvalidArgument else.
+Status CheckCameraId(std::string_view camera_id, const CameraRegistryParams& params);
 
 class CameraRegistry {
  public:

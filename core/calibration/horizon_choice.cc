@@ -29,11 +29,15 @@ HorizonUse ChooseHorizon(std::optional<double> bundle_row, int frame_height,
   }
   std::optional<double> estimate = use.frame_estimate;
   if (camera != nullptr) {
-    const CameraTrack::View view = camera->Observe(use.frame_estimate);
+    // The camera keeps rows as shares of the frame's height, so a camera that changes its frame
+    // size (a rescaled stream) keeps its estimate.
+    std::optional<double> share;
+    if (use.frame_estimate) share = *use.frame_estimate / frame_height;
+    const CameraTrack::View view = camera->Observe(share);
     if (view.row) {
       use.source = HorizonSource::kCamera;
       use.camera_frames = view.frames;
-      estimate = view.row;
+      estimate = *view.row * frame_height;
     }
   }
   if (!estimate) {

@@ -31,11 +31,11 @@ struct HorizonParams {
 
 struct HorizonEstimate {
   bool found = false;
-  double row = 0;           // full-frame image row (fractional; may be above the frame)
-  double peak_share = 0;    // share of the vote mass at the peak row
-  int segments = 0;         // oblique segments that voted
-  int peak_pairs = 0;       // pairs whose meeting row is at the peak
-  std::string reason;       // why none was found (empty when found)
+  double row = 0;         // full-frame image row (fractional; may be above the frame)
+  double peak_share = 0;  // share of the vote mass at the peak row
+  int segments = 0;       // oblique segments that voted
+  int peak_pairs = 0;     // pairs whose meeting row is at the peak
+  std::string reason;     // why none was found (empty when found)
 };
 
 HorizonEstimate EstimateHorizon(const cv::Mat3b& bgr, const HorizonParams& params = {});

@@ -38,10 +38,10 @@ Result<HorizonReference> ReferenceFromEstimates(const std::vector<HorizonEstimat
   for (const HorizonEstimate& e : estimates)
     if (e.found) rows.push_back(e.row);
   if (static_cast<int>(rows.size()) < min_frames)
-    return Status::FailedPrecondition(
-        "the horizon was found on " + std::to_string(rows.size()) + " of " +
-        std::to_string(estimates.size()) + " training frames (at least " +
-        std::to_string(min_frames) + " needed for a reference)");
+    return Status::FailedPrecondition("the horizon was found on " + std::to_string(rows.size()) +
+                                      " of " + std::to_string(estimates.size()) +
+                                      " training frames (at least " + std::to_string(min_frames) +
+                                      " needed for a reference)");
   HorizonReference r;
   r.row = Median(rows);
   std::vector<double> deviation;

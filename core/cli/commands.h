@@ -17,6 +17,7 @@ Runner AddAnalyseCommand(CLI::App& app);
 Runner AddBenchCommand(CLI::App& app);
 Runner AddCvCommand(CLI::App& app);
 Runner AddHorizonCommand(CLI::App& app);
+Runner AddCalibrateCommand(CLI::App& app);
 
 // Prints "tod: <message>" to stderr and returns 1.
 int Fail(const std::string& message);

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   add(tod::cli::AddBenchCommand);
   add(tod::cli::AddCvCommand);
   add(tod::cli::AddHorizonCommand);
+  add(tod::cli::AddCalibrateCommand);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

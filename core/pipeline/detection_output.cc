@@ -46,6 +46,24 @@ nlohmann::json DetectionToJson(const Detection& d, const std::string& image_name
   j["map_kind"] = MapKindName(d.map_kind);
   j["degraded"] = d.degraded();
   j["degraded_stages"] = d.degraded_stages;
+  j["geometry"] = GeometryToJson(d);
+  return j;
+}
+
+nlohmann::json GeometryToJson(const Detection& d) {
+  const HorizonUse& h = d.horizon;
+  const auto row = [](const std::optional<double>& r) {
+    return r ? nlohmann::json(*r) : nlohmann::json(nullptr);
+  };
+  const Box& r = d.road_region;
+  nlohmann::json j = {{"source", HorizonSourceName(h.source)},
+                      {"horizon_row", row(h.row)},
+                      {"bundle_horizon_row", row(h.bundle_row)},
+                      {"frame_horizon_row", row(h.frame_estimate)},
+                      {"camera_frames", h.camera_frames},
+                      {"shift_rows", h.shift},
+                      {"road_region", {{"x", r.x}, {"y", r.y}, {"w", r.w}, {"h", r.h}}}};
+  if (!h.fallback.empty()) j["fallback"] = h.fallback;
   return j;
 }
 

@@ -15,6 +15,9 @@ namespace tod {
 // {"image","width","height","proposals":[{"x","y","w","h","score","ordr","obdr"}],
 //  "obstacles":[{"x","y","w","h","area","peak","mean"}],"timing_ms":{stage: ms, "total": ms}}
 nlohmann::json DetectionToJson(const Detection& detection, const std::string& image_name);
+// The geometry the detection stood on: source, horizon rows, shift, road region, fallback (the
+// JSON `tod detect` writes; the server's Geometry message has the same fields).
+nlohmann::json GeometryToJson(const Detection& d);
 
 // Probability in [0,1] to 8-bit (255 = 1.0).
 cv::Mat1b ProbabilityTo8Bit(const cv::Mat1f& probability);

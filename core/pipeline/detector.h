@@ -94,6 +94,7 @@ struct Detection {
   bool degraded() const { return !degraded_stages.empty(); }
   // The horizon the geometry stood on and where it came from (bundle, frame, camera).
   HorizonUse horizon;
+  Box road_region;  // R1 on this frame, after the horizon's shift
 };
 
 struct ModelInfo {

@@ -203,6 +203,7 @@ Result<Detection> ObstacleDetector::Detect(const cv::Mat3b& bgr, const DetectOpt
   if (!timer.stopped().ok()) return timer.stopped();
   Detection out;
   out.horizon = frame.geometry.horizon;
+  if (regions.num_layers() > 0) out.road_region = regions.layers.front();
   if (oaocc.occlusion_cut_short) out.degraded_stages.push_back("occlusion");
   if (!proposals.truncated_regions.empty()) out.degraded_stages.push_back("proposals");
   frame.regressed = RegressProposals(bundle_, bgr, oaocc, regions, std::move(proposals), &timer,

@@ -82,6 +82,25 @@ Status PlaceFeatureHorizons(TrainingRun& run, GroundPlaneFit& ground_plane, Mode
   return Status::Ok();
 }
 
+// The training camera's horizon as the estimator sees it (self-calibration moves other cameras'
+// frames against it). Too few frames with an estimate leave the bundle without one, said in the
+// log and in every detection's horizon.fallback.
+void MeasureHorizonReference(TrainingRun& run, const Survey& survey, ModelBundle& bundle,
+                             nlohmann::json& parts) {
+  Result<HorizonReference> reference = ReferenceFromEstimates(survey.horizons, survey.height);
+  if (!reference.ok()) {
+    run.Say("no horizon reference: " + reference.status().message());
+    parts["horizon_reference"] = {{"error", reference.status().message()}};
+    return;
+  }
+  bundle.horizon_reference = *reference;
+  parts["horizon_reference"] = reference->ToJson();
+  char line[128];
+  std::snprintf(line, sizeof line, "horizon reference: row %.1f (spread %.1f) over %d frames",
+                reference->row, reference->spread, reference->frames);
+  run.Say(line);
+}
+
 }  // namespace
 
 // Multilayer regions and the size filter from the training obstacles (§1.4, §4.3).
@@ -108,6 +127,7 @@ Status DeriveGeometry(TrainingRun& run, const Survey& survey, ModelBundle& bundl
   }
   bundle.size_filter.enabled = options.params.size_filter;
   if (Status st = PlaceFeatureHorizons(run, ground_plane, bundle, parts); !st.ok()) return st;
+  MeasureHorizonReference(run, survey, bundle, parts);
   for (int k = 0; k < bundle.regions.num_layers(); ++k) {
     const Box& r = bundle.regions.layers[k];
     char line[96];  // snprintf: GCC 12 warns (-Wrestrict, falsely) on "R" + std::to_string

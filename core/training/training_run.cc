@@ -55,8 +55,10 @@ Result<Survey> SurveyFrames(TrainingRun& run) {
   for (int i = 0; i < n; ++i) all[i] = i;
   std::vector<cv::Size> sizes(n);
   std::vector<std::vector<ObstacleFootprint>> per_frame(n);
+  std::vector<HorizonEstimate> horizons(n);
   const std::vector<Status> statuses = run.ForEachFrame(all, [&](int i, const Sample& s) {
     sizes[i] = s.image.size();
+    horizons[i] = EstimateHorizon(s.image);
     for (const ObstacleInstance& inst : s.instances)
       per_frame[i].push_back({inst.box, inst.pixel_count()});
     return Status::Ok();
@@ -79,6 +81,7 @@ Result<Survey> SurveyFrames(TrainingRun& run) {
           ": train on frames of one camera (a bundle then maps onto any frame size)");
     }
     survey.usable.push_back(i);
+    survey.horizons.push_back(horizons[i]);
     for (const ObstacleFootprint& f : per_frame[i]) {
       survey.footprints.push_back(f);
       survey.obstacle_boxes.push_back(f.box);

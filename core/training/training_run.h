@@ -11,6 +11,7 @@
 
 #include "core/base/status.h"
 #include "core/base/types.h"
+#include "core/calibration/horizon_estimator.h"
 #include "core/datasets/bad_frames.h"
 #include "core/datasets/dataset_factory.h"
 #include "core/training/train_options.h"
@@ -70,6 +71,7 @@ struct Survey {
   std::vector<Box> obstacle_boxes;
   std::vector<int> usable;  // positions of the frames every later step visits
   std::vector<SkippedFrame> skipped;
+  std::vector<HorizonEstimate> horizons;  // per usable frame: the bundle's horizon reference
 };
 
 // The first pass: every frame's size and obstacles; frames that cannot

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/base/stage_timer.h"
+#include "core/pipeline/detector.h"
 #include "server/core/cancellation.h"
 #include "server/core/rejection.h"
 
@@ -31,11 +32,13 @@ class EngineObserver {
   virtual void OnRejected(Rejection rejection) = 0;
   // The work of a request was stopped or skipped for `reason` (also reported as a rejection).
   virtual void OnCancelled(CancelReason reason) = 0;
-  // A request produced a detection with the model named `model`: its stage times in ms
-  // ("queue", "decode", the pipeline's stages, "encode_map") and the stages its frame budget
-  // cut short.
+  // A request produced `detection` with the model named `model`: its stage times in ms
+  // ("queue", "decode", the pipeline's stages, "encode_map"); the detection says which stages
+  // its frame budget cut short and where its geometry came from.
   virtual void OnDetected(const std::string& model, const StageTimes& timings,
-                          const std::vector<std::string>& degraded_stages) = 0;
+                          const Detection& detection) = 0;
+  // The cameras whose horizon the engine keeps, after a detection.
+  virtual void OnCameras(size_t cameras) = 0;
 };
 
 }  // namespace tod::server

@@ -98,7 +98,7 @@ std::optional<InferenceResult> RunDetector(const Detector& detector, const cv::M
 
 InferenceEngine::InferenceEngine(EngineConfig config, const ModelHolder& models,
                                  EngineObserver* observer)
-    : config_(std::move(config)), models_(models), observer_(observer) {}
+    : config_(std::move(config)), models_(models), observer_(observer), cameras_(config_.cameras) {}
 
 InferenceEngine::~InferenceEngine() { Stop(); }
 
@@ -148,6 +148,9 @@ std::optional<InferenceResult> InferenceEngine::AdmissionRefusal(
                    Rejection::kNotReady);
   }
   if (Status valid = ValidateOptions(request.options); !valid.ok()) {
+    return Refusal(std::move(valid), Rejection::kBadRequest);
+  }
+  if (Status valid = CheckCameraId(request.camera_id, config_.cameras); !valid.ok()) {
     return Refusal(std::move(valid), Rejection::kBadRequest);
   }
   if (!request.model.empty() && models_.Find(request.model) == nullptr) {
@@ -272,6 +275,8 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
   }
 
   DetectOptions options = PipelineOptions(request, config_, started);
+  options.camera =
+      request.camera_id.empty() ? request.stream_camera : cameras_.Track(request.camera_id);
   // Asked between the pipeline's stages; the Status it returns is only a signal here: the result
   // is rebuilt from the reason (RunDetector) so the message says where the work stopped.
   int boundaries = 0;  // stage boundaries passed, for the message
@@ -298,7 +303,8 @@ InferenceResult InferenceEngine::Run(const Job& job) const {
     result.timings.emplace_back("encode_map", MillisecondsSince(encode_start));
   }
   if (observer_ != nullptr) {
-    observer_->OnDetected(result.model->name(), result.timings, result.detection.degraded_stages);
+    observer_->OnDetected(result.model->name(), result.timings, result.detection);
+    observer_->OnCameras(cameras_.size());
   }
   return result;
 }

@@ -23,6 +23,7 @@
 
 #include "core/base/stage_timer.h"
 #include "core/base/status.h"
+#include "core/calibration/camera_registry.h"
 #include "core/pipeline/detector.h"
 #include "server/core/cancellation.h"
 #include "server/core/engine_observer.h"
@@ -40,6 +41,11 @@ struct InferenceRequest {
   std::optional<std::chrono::steady_clock::time_point> deadline;
   // Set by the front end when its caller gives up; null: the engine makes one (deadline, drain).
   std::shared_ptr<Cancellation> cancellation;
+  // The camera the frame comes from: its horizon estimate is kept in the engine's registry
+  // (CheckCameraId bounds it at admission). Empty: `stream_camera`, the track a DetectStream
+  // keeps for its own frames, or none (the frame is calibrated alone).
+  std::string camera_id;
+  std::shared_ptr<CameraTrack> stream_camera;
 };
 
 struct InferenceResult {
@@ -69,6 +75,7 @@ struct EngineConfig {
   int threads_per_request = 1;  // cores one request may use (DetectOptions::threads)
   int queue_capacity = 16;      // requests waiting (not counting the ones running)
   ImageLimits limits;
+  CameraRegistryParams cameras;  // the cameras whose horizon the engine keeps
 };
 
 class InferenceEngine {
@@ -99,6 +106,7 @@ class InferenceEngine {
   void Stop();
 
   size_t queue_depth() const;
+  size_t cameras_tracked() const { return cameras_.size(); }
   const EngineConfig& config() const { return config_; }
 
  private:
@@ -121,6 +129,8 @@ class InferenceEngine {
   const EngineConfig config_;
   const ModelHolder& models_;
   EngineObserver* const observer_;
+  // Thread-safe on its own; mutable because looking a camera up refreshes it (Run is const).
+  mutable CameraRegistry cameras_;
 
   mutable std::mutex mutex_;  // guards everything below
   std::condition_variable work_available_;

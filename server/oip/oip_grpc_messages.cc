@@ -21,8 +21,11 @@ Result<std::string> OptionText(const std::string& name, const inference::InferPa
       return std::to_string(value.uint64_param());
     case inference::InferParameter::kDoubleParam:
       return json(value.double_param()).dump();  // the shortest text that reads back the same
+    case inference::InferParameter::kBoolParam:
+      return std::string(value.bool_param() ? "true" : "false");
     default:
-      return Status::InvalidArgument("parameter " + name + " must be a number or a string");
+      return Status::InvalidArgument("parameter " + name +
+                                     " must be a number, a string or a boolean");
   }
 }
 

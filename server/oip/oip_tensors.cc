@@ -15,10 +15,9 @@ namespace {
 using nlohmann::json;
 
 // The request parameters that are detection options: passed to ParseDetectQuery by these names.
-constexpr std::array<std::string_view, 7> kDetectOptions = {
-    "max_proposals", "obstacle_threshold", "min_obstacle_score",
-    "budget_ms",     "map_kind",           "timeout_ms",
-    "frame_id"};
+constexpr std::array<std::string_view, 9> kDetectOptions = {
+    "max_proposals", "obstacle_threshold", "min_obstacle_score", "budget_ms", "map_kind",
+    "timeout_ms",    "frame_id",           "camera_id",          "calibrate"};
 
 // Runs before the JSON becomes a document: counts values and nesting as the parser meets them
 // and stops it at the first bound crossed, so a hostile body ("[[[[..." or a million tiny
@@ -130,11 +129,12 @@ Status ReadRequestParameters(const json& request, InferRequest* out) {
     if (IsDetectOption(name)) {
       if (value.is_string()) {
         out->options[name] = value.get<std::string>();
-      } else if (value.is_number()) {
+      } else if (value.is_number() || value.is_boolean()) {
         // The shortest text that reads back as the same number; ParseDetectQuery range-checks.
         out->options[name] = value.dump();
       } else {
-        return Status::InvalidArgument("parameter " + name + " must be a number or a string");
+        return Status::InvalidArgument("parameter " + name +
+                                       " must be a number, a string or a boolean");
       }
     } else if (name == "map_format") {
       const Result<MapFormat> format =

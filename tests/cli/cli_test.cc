@@ -308,7 +308,7 @@ TEST_F(CliTest, SynthIsDeterministicForASeed) {
     ++files;
     EXPECT_EQ(read(e.path()), read(out_ / "b" / fs::relative(e.path(), out_ / "a"))) << e.path();
   }
-  EXPECT_EQ(files, 3);  // image, labelIds, instanceIds
+  EXPECT_EQ(files, 4);  // image, labelIds, instanceIds, camera truth
 }
 
 TEST_F(CliTest, ShippedDefaultModelLoadsAndDetects) {

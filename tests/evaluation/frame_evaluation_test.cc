@@ -56,8 +56,9 @@ TEST(FrameEvaluation, GivesEveryVariantAndTimesTheDetectorsPathOnly) {
     stages.push_back(stage);
     sum += ms;
   }
-  EXPECT_EQ(stages, (std::vector<std::string>{"edges", "superpixels", "occlusion", "proposals",
-                                              "features", "regression", "probability_map"}));
+  EXPECT_EQ(stages,
+            (std::vector<std::string>{"calibration", "edges", "superpixels", "occlusion",
+                                      "proposals", "features", "regression", "probability_map"}));
   EXPECT_DOUBLE_EQ(frame->total_ms, sum);
 }
 

@@ -32,12 +32,14 @@ class RecordingObserver final : public EngineObserver {
     Add(std::string("cancelled ") + CancelReasonName(reason));
   }
   void OnDetected(const std::string& model, const StageTimes& timings,
-                  const std::vector<std::string>& degraded_stages) override {
+                  const Detection& detection) override {
     std::string line = "detected " + model;
     for (const auto& [stage, ms] : timings) line += " " + stage;
-    for (const std::string& stage : degraded_stages) line += " degraded:" + stage;
+    for (const std::string& stage : detection.degraded_stages) line += " degraded:" + stage;
+    line += std::string(" geometry:") + HorizonSourceName(detection.horizon.source);
     Add(line);
   }
+  void OnCameras(size_t cameras) override { Add("cameras " + std::to_string(cameras)); }
 
   std::vector<std::string> events() const {
     std::lock_guard lock(mutex_);
@@ -74,13 +76,18 @@ class EngineObserverTest : public ::testing::Test {
     engine_ = std::make_unique<InferenceEngine>(config, models_, &observer_);
     engine_->Start();
   }
-  // Submits the test frame with `options`; the future has the result.
-  std::future<InferenceResult> Submit(const DetectOptions& options = {}) {
+  // Submits the test frame with `options` (of camera `camera_id`, or of the stream whose track
+  // is `stream_camera`); the future has the result.
+  std::future<InferenceResult> Submit(const DetectOptions& options = {},
+                                      const std::string& camera_id = "",
+                                      std::shared_ptr<CameraTrack> stream_camera = nullptr) {
     auto promise = std::make_shared<std::promise<InferenceResult>>();
     std::future<InferenceResult> future = promise->get_future();
     InferenceRequest request;
     request.image = image_;
     request.options = options;
+    request.camera_id = camera_id;
+    request.stream_camera = std::move(stream_camera);
     engine_->Submit(request,
                     [promise](InferenceResult result) { promise->set_value(std::move(result)); });
     return future;
@@ -97,10 +104,11 @@ using Events = std::vector<std::string>;
 TEST_F(EngineObserverTest, ReportsADetectionFromAdmissionToAnswer) {
   SetUpEngine(std::make_shared<DegradedDetector>());
   ASSERT_TRUE(Submit().get().status.ok());
-  EXPECT_EQ(
-      observer_.events(),
-      (Events{"accepted 1", "queue 0", "started",
-              "detected gated queue decode fake_stage encode_map degraded:regression", "finished"}));
+  EXPECT_EQ(observer_.events(),
+            (Events{"accepted 1", "queue 0", "started",
+                    "detected gated queue decode fake_stage encode_map degraded:regression "
+                    "geometry:bundle",
+                    "cameras 0", "finished"}));
 }
 
 TEST_F(EngineObserverTest, ReportsARefusalAtAdmissionAsARejectionOnly) {
@@ -109,6 +117,33 @@ TEST_F(EngineObserverTest, ReportsARefusalAtAdmissionAsARejectionOnly) {
   too_many.max_proposals = kMaxRequestProposals + 1;
   EXPECT_EQ(Submit(too_many).get().rejection, Rejection::kBadRequest);
   EXPECT_EQ(observer_.events(), (Events{"rejected bad_request"}));
+}
+
+// Frames naming a camera share its track in the engine's registry; a stream's own track is used
+// when they name none; a camera_id that is too long or not printable is refused at admission.
+TEST_F(EngineObserverTest, KeepsOneTrackPerCameraAndRefusesBadCameraIds) {
+  SetUpEngine(std::make_shared<testing::GatedDetector>("v1"));
+  EXPECT_EQ(Submit({}, "cam-a").get().detection.horizon.camera_frames, 1);
+  EXPECT_EQ(Submit({}, "cam-a").get().detection.horizon.camera_frames, 2);
+  EXPECT_EQ(Submit({}, "cam-b").get().detection.horizon.camera_frames, 1);
+  EXPECT_EQ(engine_->cameras_tracked(), 2u);
+  auto stream = std::make_shared<CameraTrack>();
+  EXPECT_EQ(Submit({}, "", stream).get().detection.horizon.camera_frames, 1);
+  EXPECT_EQ(Submit({}, "", stream).get().detection.horizon.camera_frames, 2);
+  EXPECT_EQ(Submit({}, "cam-a", stream).get().detection.horizon.camera_frames, 3);  // named
+  EXPECT_EQ(engine_->cameras_tracked(), 2u);  // a stream's track is not in the registry
+  const InferenceResult alone = Submit().get();
+  EXPECT_EQ(alone.detection.horizon.source, HorizonSource::kBundle);
+  EXPECT_EQ(alone.detection.horizon.camera_frames, 0);
+
+  for (const std::string& bad : {std::string(129, 'c'), std::string("cam a"),
+                                 std::string("cam\x01"), std::string("cam\xc3\xa9")}) {
+    const InferenceResult refused = Submit({}, bad).get();
+    EXPECT_EQ(refused.rejection, Rejection::kBadRequest) << bad;
+    EXPECT_NE(refused.status.message().find("camera_id"), std::string::npos);
+  }
+  EXPECT_EQ(Submit({}, std::string(128, 'c')).get().status.ok(), true);
+  EXPECT_EQ(engine_->cameras_tracked(), 3u);
 }
 
 TEST_F(EngineObserverTest, ReportsAFullQueueAndTheDrainOfQueuedWork) {
@@ -176,11 +211,25 @@ TEST(ServerMetricsAsObserverTest, CountsTheEnginesEvents) {
   EXPECT_EQ(Series(metrics, "tod_rejections_total{reason=\"queue_full\"}"), 1);
   EXPECT_EQ(Series(metrics, "tod_requests_cancelled_total{reason=\"client_disconnected\"}"), 1);
   EXPECT_EQ(Series(metrics, "tod_requests_cancelled_total{reason=\"drain\"}"), 0);
-  observer.OnDetected("cam7", {{"decode", 500}, {"proposals", 1500}}, {"proposals"});
-  EXPECT_EQ(Series(metrics, "tod_model_frames_total{model=\"cam7\"}"), 1);
+  Detection detection;
+  detection.degraded_stages = {"proposals"};
+  detection.horizon.fallback = "no horizon estimate";
+  EXPECT_EQ(Series(metrics, "tod_geometry_fallbacks_total"), 0);
+  observer.OnDetected("cam7", {{"decode", 500}, {"proposals", 1500}}, detection);
+  detection.horizon = HorizonUse{};
+  detection.horizon.source = HorizonSource::kCamera;
+  detection.horizon.camera_frames = 3;
+  observer.OnDetected("cam7", {}, detection);
+  observer.OnCameras(4);
+  EXPECT_EQ(Series(metrics, "tod_geometry_total{source=\"bundle\"}"), 1);
+  EXPECT_EQ(Series(metrics, "tod_geometry_total{source=\"camera\"}"), 1);
+  EXPECT_EQ(Series(metrics, "tod_geometry_total{source=\"frame\"}"), 0);
+  EXPECT_EQ(Series(metrics, "tod_geometry_fallbacks_total"), 1);
+  EXPECT_EQ(Series(metrics, "tod_cameras_tracked"), 4);
+  EXPECT_EQ(Series(metrics, "tod_model_frames_total{model=\"cam7\"}"), 2);
   EXPECT_EQ(Series(metrics, "tod_stage_duration_seconds_sum{stage=\"decode\"}"), 0.5);
   EXPECT_EQ(Series(metrics, "tod_stage_duration_seconds_count{stage=\"proposals\"}"), 1);
-  EXPECT_EQ(Series(metrics, "tod_frames_degraded_total{stage=\"proposals\"}"), 1);
+  EXPECT_EQ(Series(metrics, "tod_frames_degraded_total{stage=\"proposals\"}"), 2);
   EXPECT_EQ(Series(metrics, "tod_frames_degraded_total{stage=\"regression\"}"), 0);
 }
 

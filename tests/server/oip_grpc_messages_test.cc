@@ -116,9 +116,22 @@ TEST(OipGrpcMessages, TypedParametersBecomeTheQueryOptions) {
   EXPECT_EQ(frame_id, "cam7-0001");
   EXPECT_EQ(inference.options.max_proposals, 25);
 
+  // Booleans are read as "true"/"false": calibrate takes one, a number option refuses it.
+  parameters["calibrate"].set_bool_param(false);
+  parameters["camera_id"].set_string_param("cam7");
+  const Result<InferRequest> calibrated = FromModelInferRequest(request, {});
+  ASSERT_TRUE(calibrated.ok());
+  ASSERT_TRUE(ApplyOptions(*calibrated, &inference, &frame_id).ok());
+  EXPECT_FALSE(inference.options.calibrate);
+  EXPECT_EQ(inference.camera_id, "cam7");
   parameters["max_proposals"].set_bool_param(true);
+  const Result<InferRequest> boolean = FromModelInferRequest(request, {});
+  ASSERT_TRUE(boolean.ok());
+  EXPECT_NE(ApplyOptions(*boolean, &inference, &frame_id).message().find("max_proposals"),
+            std::string::npos);
+  parameters["max_proposals"].clear_parameter_choice();  // no value at all
   ExpectRefused(FromModelInferRequest(request, {}), StatusCode::kInvalidArgument,
-                "parameter max_proposals must be a number or a string");
+                "parameter max_proposals must be a number, a string or a boolean");
   parameters["max_proposals"].set_int64_param(-3);
   const Result<InferRequest> negative = FromModelInferRequest(request, {});
   ASSERT_TRUE(negative.ok());

@@ -283,8 +283,8 @@ TEST(OipTensorsTest, ParametersAndOutputsAreTypeChecked) {
     request["parameters"] = std::move(parameters);
     return request.dump();
   };
-  ExpectRefused(Parse(with_parameters({{"max_proposals", true}})), bad,
-                "max_proposals must be a number or a string");
+  ExpectRefused(Parse(with_parameters({{"max_proposals", {{"a", 1}}}})), bad,
+                "max_proposals must be a number, a string or a boolean");
   ExpectRefused(Parse(with_parameters({{"frame_id", {1, 2}}})), bad, "frame_id must be");
   ExpectRefused(Parse(with_parameters({{"map_format", "jpeg"}})), bad, "map_format");
   ExpectRefused(Parse(with_parameters({{"binary_data_output", "yes"}})), bad,

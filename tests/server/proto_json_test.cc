@@ -33,6 +33,8 @@ InferenceResult SampleResult() {
   detection.probability = cv::Mat1f(20, 40, 0.f);
   detection.map_kind = MapKind::kCalibrated;
   detection.degraded_stages = {"regression"};
+  detection.horizon = {HorizonSource::kCamera, 9.5, 8.0, 10.0, 20, 1.5, ""};
+  detection.road_region = Box{0, 10, 40, 10};
   result.map_png = "PNG";
   result.timings = {{"queue", 1.5}, {"decode", 2.0}};
   result.total_ms = 9.5;
@@ -54,7 +56,10 @@ TEST(ProtoJsonTest, CompactDetectResponseBytes) {
       R"("proposals":[{"box":{"x":5,"y":6,"w":7,"h":8},"fused":1.5,"ordr":1,"obdr":0.25}],)"
       R"("probability_map":{"width":40,"height":20,"png":"UE5H","kind":"MAP_KIND_CALIBRATED"},)"
       R"("timings":[{"stage":"queue","ms":1.5},{"stage":"decode","ms":2}],"total_ms":9.5,)"
-      R"("degraded":true,"degraded_stages":["regression"]})");
+      R"("degraded":true,"degraded_stages":["regression"],)"
+      R"("geometry":{"source":"camera","camera_frames":20,"shift_rows":1.5,)"
+      R"("road_region":{"x":0,"y":10,"w":40,"h":10},"fallback":"",)"
+      R"("horizon_row":9.5,"bundle_horizon_row":8,"frame_horizon_row":10}})");
 }
 
 TEST(ProtoJsonTest, DefaultsArePrintedAndAnUnsetMapIsLeftOut) {
@@ -117,7 +122,22 @@ constexpr char kIndentedSample[] = R"({
  "degraded": true,
  "degraded_stages": [
   "regression"
- ]
+ ],
+ "geometry": {
+  "source": "camera",
+  "camera_frames": 20,
+  "shift_rows": 1.5,
+  "road_region": {
+   "x": 0,
+   "y": 10,
+   "w": 40,
+   "h": 10
+  },
+  "fallback": "",
+  "horizon_row": 9.5,
+  "bundle_horizon_row": 8,
+  "frame_horizon_row": 10
+ }
 }
 )";
 
@@ -157,9 +177,13 @@ using KeyList = std::vector<std::string>;
 
 TEST(ProtoJsonTest, KeysOfEveryLevel) {
   const nlohmann::json json = nlohmann::json::parse(MessageToJson(SampleResponse()));
-  EXPECT_EQ(Keys(json),
-            (KeyList{"degraded", "degraded_stages", "frame_id", "height", "model_version",
-                     "obstacles", "probability_map", "proposals", "timings", "total_ms", "width"}));
+  EXPECT_EQ(Keys(json), (KeyList{"degraded", "degraded_stages", "frame_id", "geometry", "height",
+                                 "model_version", "obstacles", "probability_map", "proposals",
+                                 "timings", "total_ms", "width"}));
+  // The optional rows (proto3 `optional`) are printed after the other fields, when set.
+  EXPECT_EQ(Keys(json["geometry"]),
+            (KeyList{"bundle_horizon_row", "camera_frames", "fallback", "frame_horizon_row",
+                     "horizon_row", "road_region", "shift_rows", "source"}));
   EXPECT_EQ(Keys(json["obstacles"][0]),
             (KeyList{"area", "box", "evidence", "mean_probability", "peak_probability", "score"}));
   EXPECT_EQ(Keys(json["obstacles"][0]["box"]), (KeyList{"h", "w", "x", "y"}));
@@ -201,6 +225,11 @@ TEST(ProtoJsonTest, AgreesWithTheCliJsonOnADetection) {
   EXPECT_EQ(api["probability_map"]["kind"], "MAP_KIND_CALIBRATED");
   EXPECT_EQ(cli["degraded"], api["degraded"]);
   EXPECT_EQ(cli["degraded_stages"], api["degraded_stages"]);
+  // The geometry has the same keys and numbers in both (the CLI leaves an empty fallback out).
+  for (const char* key : {"source", "horizon_row", "bundle_horizon_row", "frame_horizon_row",
+                          "camera_frames", "shift_rows", "road_region"}) {
+    EXPECT_EQ(cli["geometry"][key], api["geometry"][key]) << key;
+  }
 }
 
 }  // namespace

@@ -109,6 +109,8 @@ TEST(ConfigTest, HttpLimitsComeFromEverySourceAndAreRangeChecked) {
   EXPECT_EQ(defaults->max_image_pixels, 4'000'000);
   EXPECT_EQ(defaults->http_max_header_bytes, 16u * 1024);
   EXPECT_EQ(defaults->http_max_connections_per_client, 64);
+  EXPECT_EQ(defaults->max_cameras, 1024);
+  EXPECT_EQ(defaults->camera_idle_s, 600);
 
   const std::string file =
       WriteTempFile("tod_config_http.json", R"({"model": "/m", "http_max_connections": 100,
@@ -134,6 +136,8 @@ TEST(ConfigTest, HttpLimitsComeFromEverySourceAndAreRangeChecked) {
       {"http_max_buffered_bytes", "1000"},
       {"drain_timeout_s", "1e300"},
       {"http_threads", "1000"},
+      {"max_cameras", "0"},
+      {"camera_idle_s", "0"},
   };
   for (const auto& [key, value] : bad) {
     const Result<ServerConfig> refused =

@@ -44,6 +44,11 @@ class GatedDetector : public Detector {
       detection.proposals.push_back({Box{i, i, 4, 4}, 1.f - 0.1f * i, 0.5f, 0.25f});
     }
     if (options.want_probability_map) detection.probability = cv::Mat1f(bgr.size(), 0.25f);
+    // As the real detector does: a frame of a camera adds to that camera's estimate.
+    if (options.camera) {
+      detection.horizon.source = HorizonSource::kCamera;
+      detection.horizon.camera_frames = options.camera->Observe(0.5).frames;
+    }
     detection.timings = {{"fake_stage", 0.5}};
     return detection;
   }

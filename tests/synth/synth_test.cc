@@ -106,7 +106,7 @@ TEST(Synth, SameSeedSameBytesDifferentSeedDifferentImage) {
     EXPECT_EQ(FileBytes(entry.path()), FileBytes(dir.path() / "b" / rel)) << rel;
     if (FileBytes(entry.path()) != FileBytes(dir.path() / "c" / rel)) ++differing_from_c;
   }
-  EXPECT_EQ(files, 9);             // 3 frames x (image, labelIds, instanceIds)
+  EXPECT_EQ(files, 12);            // 3 frames x (image, labelIds, instanceIds, camera truth)
   EXPECT_GE(differing_from_c, 3);  // at least every image differs
 
   const Sample x = GenerateSynthFrame(params, 5, "x");
