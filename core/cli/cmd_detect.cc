@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/base/atomic_file.h"
+#include "core/calibration/camera_registry.h"
 #include "core/cli/commands.h"
 #include "core/cli/request_options.h"
 #include "core/data/image_file.h"
@@ -25,6 +26,7 @@ struct DetectArgs {
   std::string model, out;
   std::vector<std::string> images;
   DetectOptions options;
+  std::string camera_id;  // the images are frames of this camera (one horizon estimate)
   bool stages = false;
 };
 
@@ -47,6 +49,13 @@ void AddDetectOptions(CLI::App* cmd, const std::shared_ptr<DetectArgs>& args) {
       ->check(
           CLI::IsMember({MapKindName(MapKind::kNormalized), MapKindName(MapKind::kCalibrated)}));
   AddFrameRequestOptions(cmd, &args->options);
+  cmd->add_option("--camera-id", args->camera_id,
+                  "the images are frames of one camera: each frame's horizon estimate joins the "
+                  "camera's, and every frame uses the camera's median so far (as the server does "
+                  "for a camera_id)");
+  cmd->add_flag(
+      "--no-calibrate", [args](std::int64_t) { args->options.calibrate = false; },
+      "use the bundle's geometry as trained instead of calibrating it to each frame's horizon");
   cmd->add_flag(
       "--stages", args->stages,
       "also write each stage as PNG (STEM_stage_*.png) and its counts (STEM_stages.json)");
@@ -127,6 +136,11 @@ Runner AddDetectCommand(CLI::App& app) {
     // The stage pictures need the detector's trace, which only the bundle's own detector keeps.
     const auto detector = std::dynamic_pointer_cast<const ObstacleDetector>(*loaded);
     if (detector == nullptr) return Fail(args->model + ": not an obstacle detector bundle");
+    if (!args->camera_id.empty()) {
+      if (Status st = CheckCameraId(args->camera_id, CameraRegistryParams{}); !st.ok())
+        return Fail("--camera-id: " + st.message());
+      args->options.camera = std::make_shared<CameraTrack>();
+    }
     // One-off costs of the process (warm_up.h) are paid here, not by the first frame's budget.
     if (const Result<double> warmed = WarmUp(*detector); !warmed.ok())
       return Fail(warmed.status().message());
