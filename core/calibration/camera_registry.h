@@ -21,6 +21,9 @@ namespace tod {
 // One camera's estimate, shared by the requests of that camera.
 class CameraTrack {
  public:
+  CameraTrack() = default;
+  // A track that has already seen these frames (an evaluation replaying a camera's split).
+  explicit CameraTrack(const CameraHorizon& seen) : horizon_(seen) {}
   // Adds a frame's estimate when there is one, then returns the camera's median and its frames
   // (in whatever unit the caller keeps: ChooseHorizon uses shares of the frame's height).
   struct View {

@@ -1,5 +1,5 @@
 // tod cv --data DIR --work DIR [--folds 5] [--seeds 1] [--seed S] [--paper NAME] [--json FILE]
-//        [--keep-models | --reuse-models]
+//        [--keep-models | --reuse-models] [--geometry frame|camera|bundle]
 // Cross-validates the training recipe (tod train's defaults) over K folds of consecutive frames
 // and N seeds (core/validation/cross_validation.h): trains on K-1 folds, evaluates on the one
 // left out, and prints the headline metrics per fold with their mean and min-max spread; the
@@ -8,6 +8,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/cli/commands.h"
+#include "core/cli/eval_geometry_option.h"
 #include "core/cli/paper_option.h"
 #include "core/validation/cross_validation.h"
 
@@ -51,6 +52,7 @@ Runner AddCvCommand(CLI::App& app) {
                 "evaluate the bundles --keep-models left under --work instead of training "
                 "(the same models under other detection options or evaluation code)")
       ->excludes("--keep-models");
+  AddEvalGeometryOption(cmd, &args->eval.geometry);
   cmd->add_option("--json", args->json, "write every number under \"cv\" to this file");
   return [args] {
     BoundOpenCvThreads(args->recipe.threads);

@@ -18,6 +18,7 @@ Runner AddBenchCommand(CLI::App& app);
 Runner AddCvCommand(CLI::App& app);
 Runner AddHorizonCommand(CLI::App& app);
 Runner AddCalibrateCommand(CLI::App& app);
+Runner AddReframeCommand(CLI::App& app);
 
 // Prints "tod: <message>" to stderr and returns 1.
 int Fail(const std::string& message);

@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   add(tod::cli::AddCvCommand);
   add(tod::cli::AddHorizonCommand);
   add(tod::cli::AddCalibrateCommand);
+  add(tod::cli::AddReframeCommand);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

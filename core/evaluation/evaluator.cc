@@ -8,10 +8,14 @@
 #include <optional>
 #include <sstream>
 
+#include "core/calibration/camera_horizon.h"
+#include "core/calibration/camera_registry.h"
+#include "core/calibration/horizon_estimator.h"
 #include "core/datasets/dataset_factory.h"
 #include "core/evaluation/component_evaluation.h"
 #include "core/evaluation/frame_evaluation.h"
 #include "core/metrics/instance_recall.h"
+#include "core/pipeline/frame_geometry.h"
 #include "core/pipeline/obstacle_detector.h"
 #include "core/pipeline/parallel.h"
 
@@ -57,6 +61,24 @@ nlohmann::json NumberOrNull(double v) {
 }
 
 }  // namespace
+
+const char* EvalGeometryName(EvalGeometry geometry) {
+  switch (geometry) {
+    case EvalGeometry::kCamera:
+      return "camera";
+    case EvalGeometry::kBundle:
+      return "bundle";
+    case EvalGeometry::kFrame:
+      break;
+  }
+  return "frame";
+}
+
+std::optional<EvalGeometry> ParseEvalGeometry(const std::string& name) {
+  for (const EvalGeometry g : {EvalGeometry::kFrame, EvalGeometry::kCamera, EvalGeometry::kBundle})
+    if (name == EvalGeometryName(g)) return g;
+  return std::nullopt;
+}
 
 namespace {
 
@@ -109,6 +131,8 @@ class EvalTotals {
       stage_ms_[stage].push_back(ms);
     }
     stage_ms_["total"].push_back(frame.total_ms);
+    ++geometry_sources_[HorizonSourceName(frame.horizon.source)];
+    abs_shifts_.push_back(std::abs(frame.horizon.shift));
     return Status::Ok();
   }
 
@@ -118,6 +142,8 @@ class EvalTotals {
     report.reported = reported_;
     report.reported.components = reported_components_.Summary();
     report.list_sweep = list_sweep_;
+    report.geometry_sources = geometry_sources_;
+    report.median_abs_shift_rows = Median(abs_shifts_);
     for (const auto& [variant, store] : component_maps_) {
       MapComponents& c = report.components[variant];
       c.level = histograms_.at(variant).BestF1Level();
@@ -164,7 +190,42 @@ class EvalTotals {
   bool road_labelled_ = false, not_obstacle_ = false;
   std::vector<std::string> stage_order_;
   std::map<std::string, std::vector<double>> stage_ms_;
+  std::map<std::string, int> geometry_sources_;
+  std::vector<double> abs_shifts_;
 };
+
+// EvalGeometry::kCamera: every frame's own horizon estimate, as the share of its height a
+// CameraTrack keeps (none where the frame has none or the bundle no reference). Frames that do
+// not load have none here; the evaluation reports their error.
+std::vector<std::optional<double>> CameraFrameShares(const ModelBundle& bundle,
+                                                     const Dataset& dataset,
+                                                     const std::vector<int>& frames, int threads) {
+  std::vector<std::optional<double>> shares(frames.size());
+  ParallelFor(static_cast<int>(frames.size()), threads, [&](int i) -> Status {
+    Result<Sample> loaded = dataset.Load(frames[i]);
+    if (!loaded.ok() || !BundleHorizonRow(bundle, loaded->image.cols, loaded->image.rows))
+      return Status::Ok();
+    const HorizonEstimate estimate = EstimateHorizon(loaded->image);
+    if (estimate.found) shares[i] = estimate.row / loaded->image.rows;
+    return Status::Ok();
+  });
+  return shares;
+}
+
+// The detector's options for frame i: the defaults, calibrated as `geometry` says. A camera
+// frame gets a track that has seen every other frame of the split, so that with its own estimate
+// it stands on the camera's median over the whole split, whatever order the frames run in.
+DetectOptions FrameDetectOptions(EvalGeometry geometry,
+                                 const std::vector<std::optional<double>>& camera_shares, int i) {
+  DetectOptions options;
+  options.calibrate = geometry != EvalGeometry::kBundle;
+  if (geometry != EvalGeometry::kCamera) return options;
+  CameraHorizon seen;
+  for (int j = 0; j < static_cast<int>(camera_shares.size()); ++j)
+    if (j != i && camera_shares[j]) seen.Add(*camera_shares[j]);
+  options.camera = std::make_shared<CameraTrack>(seen);
+  return options;
+}
 
 // One frame's evaluation with the sample it was measured on, waiting for its turn in the totals.
 struct EvaluatedFrame {
@@ -181,6 +242,10 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   const int n = static_cast<int>(selection->frames.size());
   EvalTotals totals(bundle.params.obstacle_calibration.fitted);
   const ObstacleDetector detector(bundle, "eval");  // one copy of the bundle for the run
+  const std::vector<std::optional<double>> camera_shares =
+      options.geometry == EvalGeometry::kCamera
+          ? CameraFrameShares(bundle, dataset, selection->frames, options.threads)
+          : std::vector<std::optional<double>>();
   // Frames finish in any order, but the totals are added in frame order: pooled floating-point
   // means (sIoU, PPV) then do not depend on the thread count or on scheduling.
   std::mutex mutex;
@@ -203,7 +268,9 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
   std::vector<Status> per_frame = ParallelFor(n, options.threads, [&](int i) -> Status {
     Result<Sample> loaded = dataset.Load(selection->frames[i]);
     Result<FrameEvaluation> frame =
-        loaded.ok() ? EvaluateFrame(detector, *loaded) : Result<FrameEvaluation>(loaded.status());
+        loaded.ok() ? EvaluateFrame(detector, *loaded,
+                                    FrameDetectOptions(options.geometry, camera_shares, i))
+                    : Result<FrameEvaluation>(loaded.status());
     if (!frame.ok()) {
       finish(i, std::nullopt);
       return frame.status();
@@ -221,6 +288,7 @@ Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& o
       options.data.on_bad_frame, &report.skipped);
   if (!bad.ok()) return bad;
   report.frames = n - static_cast<int>(report.skipped.size());
+  report.geometry = options.geometry;
   report.map_isolation_exponent = bundle.params.probability_map.isolation.exponent;
   report.map_superpixel_shares = bundle.params.probability_map.superpixel_shares;
   report.calibration_flat = bundle.params.obstacle_calibration.flat;
@@ -272,6 +340,9 @@ nlohmann::json EvalReportToJson(const EvalReport& r) {
   j["frames"] = r.frames;
   j["instances"] = r.instances;
   j["skipped_frames"] = SkippedFramesToJson(r.skipped);
+  j["geometry"] = {{"mode", EvalGeometryName(r.geometry)},
+                   {"sources", r.geometry_sources},
+                   {"median_abs_shift_rows", r.median_abs_shift_rows}};
   const ReportedObstacleCounts& a = r.reported;
   const auto per = [](int count, int frames) -> nlohmann::json {
     return frames > 0 ? nlohmann::json(static_cast<double>(count) / frames) : nlohmann::json();
@@ -444,6 +515,9 @@ std::string FormatEvalTables(const EvalReport& r) {
   o << "\n" << FormatObstacleListSweep(r.list_sweep, r.instances, r.frames);
   o << "\nAverage recall (regressed, score > 0.25)\n";
   for (const auto& v : RegressionVariants()) FormatRecallRow(v, r.regression.at(v), o);
+  o << "\nGeometry (" << EvalGeometryName(r.geometry) << "):";
+  for (const auto& [source, frames] : r.geometry_sources) o << " " << source << " " << frames;
+  o << " frames; median |shift| " << Fixed(r.median_abs_shift_rows, 1) << " rows\n";
   o << "\nMedian time per frame (ms)\n";
   for (const auto& [stage, ms] : r.stage_median_ms) {
     std::snprintf(line, sizeof line, "%-16s %9.1f\n", stage.c_str(), ms);

@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,8 +21,19 @@
 
 namespace tod {
 
+// Where the detector's road geometry comes from in an evaluation (self-calibration, issue 48).
+enum class EvalGeometry {
+  kFrame,   // each frame calibrated alone: what a request without camera_id gets
+  kCamera,  // the split is one camera's frames: each stands on the camera's median over all
+  kBundle,  // no calibration: the bundle's geometry
+};
+// "frame" / "camera" / "bundle"; ParseEvalGeometry is its inverse (nullopt for anything else).
+const char* EvalGeometryName(EvalGeometry geometry);
+std::optional<EvalGeometry> ParseEvalGeometry(const std::string& name);
+
 struct EvalOptions {
   DatasetSelection data;  // the test split by default
+  EvalGeometry geometry = EvalGeometry::kFrame;
   int threads = 0;
   std::function<void(const std::string&)> progress;
 };
@@ -86,6 +98,11 @@ struct EvalReport {
   // Per ComponentMapVariants(): the paper's served map and the calibrated map when evaluated.
   std::map<std::string, MapComponents> components;
   std::vector<std::pair<std::string, double>> stage_median_ms;  // detector stages + "total"
+  // How the geometry was calibrated, and the frames that stood on each source (HorizonSource
+  // names) with the median absolute shift of the bundle's rows, in rows.
+  EvalGeometry geometry = EvalGeometry::kFrame;
+  std::map<std::string, int> geometry_sources;
+  double median_abs_shift_rows = 0;
 };
 
 Result<EvalReport> EvaluateModel(const ModelBundle& bundle, const EvalOptions& options);

@@ -60,10 +60,10 @@ struct DetectorPath {
 };
 
 Result<DetectorPath> RunDetectorPath(const ObstacleDetector& detector, const Sample& s,
-                                     FrameEvaluation& out) {
+                                     const DetectOptions& options, FrameEvaluation& out) {
   DetectorPath path;
   // The defaults `tod detect` reports obstacles at; every proposal feeds the map either way.
-  Result<Detection> detected = detector.Detect(s.image, DetectOptions{}, &path.trace);
+  Result<Detection> detected = detector.Detect(s.image, options, &path.trace);
   if (!detected.ok()) return detected.status();
   path.detection = std::move(detected).value();
   out.ranked["OAOCC+OLP@4+MS"] = RankedOnCommonScale(path.trace.regressed.proposals);
@@ -139,11 +139,13 @@ Status MeasureReportedObstacles(const Sample& s, const FrameTrace& trace,
 
 }  // namespace
 
-Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sample& sample) {
+Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sample& sample,
+                                      const DetectOptions& options) {
   const ModelBundle& bundle = detector.bundle();
   FrameEvaluation out;
-  Result<DetectorPath> path = RunDetectorPath(detector, sample, out);
+  Result<DetectorPath> path = RunDetectorPath(detector, sample, options, out);
   if (!path.ok()) return path.status();
+  out.horizon = path->detection.horizon;
   // The baselines stand on the geometry the detector used (calibrated like it).
   if (Status st = AddPlainEdgeBaselines(bundle, sample, path->trace.geometry, out); !st.ok())
     return st;

@@ -53,10 +53,13 @@ struct FrameEvaluation {
   // the other variants run outside it.
   StageTimes stage_times;
   double total_ms = 0;
+  HorizonUse horizon;  // the geometry the detector stood on (self-calibration)
 };
 
 // The detector's own path comes from one Detect call (its FrameTrace); the baselines and the
-// paper's other variants are computed beside it from that trace.
-Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sample& sample);
+// paper's other variants are computed beside it from that trace. `options`: the detector's
+// defaults, except for how the geometry is calibrated (DetectOptions::calibrate, ::camera).
+Result<FrameEvaluation> EvaluateFrame(const ObstacleDetector& detector, const Sample& sample,
+                                      const DetectOptions& options = {});
 
 }  // namespace tod

@@ -654,6 +654,52 @@ TEST_F(MasksCliTest, CrossValidationOverFoldsOfConsecutiveFrames) {
   EXPECT_NE(laf.output.find("masks layout"), std::string::npos) << laf.output;
 }
 
+// `tod reframe` makes the frames another camera's (here one that sees the road a tenth of the
+// height higher, JPEG); `tod eval --geometry camera` stands them on the camera's horizon over the
+// split, which is the bundle's moved by about the shift; --geometry bundle does not move it.
+TEST_F(MasksCliTest, ReframedFramesAreAnotherCameraTheEvalCalibratesTo) {
+  const fs::path reframed = out_ / "camera";
+  const CommandResult made = RunCommand(tod_ + " reframe --data " + Root() + " --out " +
+                                        reframed.string() + " --shift-up 0.1 --format jpg");
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const cv::Mat original = cv::imread((fs::path(Root()) / "images" / "2.png").string());
+  const cv::Mat image = cv::imread((reframed / "images" / "2.jpg").string());
+  const cv::Mat mask =
+      cv::imread((reframed / "labels_masks" / "2.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(image.empty());
+  ASSERT_EQ(image.size(), original.size());
+  const int shift = original.rows / 10;
+  EXPECT_EQ(cv::countNonZero(mask.rowRange(mask.rows - shift, mask.rows) != 255), 0)
+      << "the uncovered rows are void";
+
+  const auto eval = [&](const std::string& geometry) {
+    const std::string json = (out_ / (geometry + ".json")).string();
+    const CommandResult run =
+        RunCommand(tod_ + " eval --data " + reframed.string() + " --format masks --model " +
+                   tod::testing_env::TestModel() + " --max-frames 6 --threads 2 --geometry " +
+                   geometry + " --json " + json);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("Geometry (" + geometry + ")"), std::string::npos) << run.output;
+    std::ifstream in(json);
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json camera = eval("camera");
+  const int frames = camera["frames"].get<int>();
+  EXPECT_EQ(camera["geometry"]["mode"], "camera");
+  EXPECT_EQ(camera["geometry"]["sources"].value("camera", 0), frames) << camera["geometry"].dump();
+  EXPECT_NEAR(camera["geometry"]["median_abs_shift_rows"].get<double>(), shift,
+              0.03 * original.rows)
+      << camera["geometry"].dump();
+  const nlohmann::json bundle = eval("bundle");
+  EXPECT_EQ(bundle["geometry"]["sources"].value("bundle", 0), frames) << bundle["geometry"].dump();
+  EXPECT_EQ(bundle["geometry"]["median_abs_shift_rows"].get<double>(), 0.0);
+
+  const CommandResult bad = RunCommand(tod_ + " reframe --data " + Root() + " --out " +
+                                       (out_ / "bad").string() + " --crop 4000x10");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--crop"), std::string::npos) << bad.output;
+}
+
 }  // namespace
 
 // Truth boxes as positives (the default): every training obstacle's own box is one more positive
