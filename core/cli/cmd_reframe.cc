@@ -109,10 +109,12 @@ Runner AddReframeCommand(CLI::App& app) {
       if (!st.ok()) return Fail(st.message());
     }
     // The frames keep their names, so the dataset's splits still hold.
-    if (fs::is_regular_file(data / "split.txt", ec))
+    std::error_code no_split;
+    if (fs::is_regular_file(data / "split.txt", no_split)) {
       fs::copy_file(data / "split.txt", out / "split.txt", fs::copy_options::overwrite_existing,
                     ec);
-    if (ec) return Fail("cannot copy split.txt: " + ec.message());
+      if (ec) return Fail("cannot copy split.txt: " + ec.message());
+    }
     std::printf("reframed %zu frames into %s\n", images.size(), out.c_str());
     return 0;
   };

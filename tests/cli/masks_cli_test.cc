@@ -694,6 +694,14 @@ TEST_F(MasksCliTest, ReframedFramesAreAnotherCameraTheEvalCalibratesTo) {
   EXPECT_EQ(bundle["geometry"]["sources"].value("bundle", 0), frames) << bundle["geometry"].dump();
   EXPECT_EQ(bundle["geometry"]["median_abs_shift_rows"].get<double>(), 0.0);
 
+  // A set without split.txt is reframed whole.
+  ASSERT_TRUE(fs::remove(reframed / "split.txt"));
+  const CommandResult again = RunCommand(tod_ + " reframe --data " + reframed.string() + " --out " +
+                                         (out_ / "again").string() + " --scale 0.5");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(cv::imread((out_ / "again" / "images" / "2.png").string()).rows, original.rows / 2);
+  EXPECT_FALSE(fs::exists(out_ / "again" / "split.txt"));
+
   const CommandResult bad = RunCommand(tod_ + " reframe --data " + Root() + " --out " +
                                        (out_ / "bad").string() + " --crop 4000x10");
   EXPECT_NE(bad.exit_code, 0);
