@@ -1,7 +1,8 @@
 // tod horizon --data DIR [--split test] [--json FILE]   |   tod horizon IMAGE...
 // The horizon the detector's self-calibration estimates on each frame (issue 48), and, where
 // the frames are synthetic (tod synth writes each frame's true camera), its error in rows per
-// frame and per camera: the running median over the frames sent so far, as the server keeps it.
+// frame and per camera: the running median over the frames sent so far, as the server keeps it,
+// against the median true horizon of those frames.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -26,6 +27,9 @@ struct FrameHorizon {
   HorizonEstimate estimate;
   std::optional<double> truth;   // synthetic frames: the camera's true horizon row
   std::optional<double> camera;  // running median of the frames so far, this one included
+  // The camera's true horizon over the same frames: the running median of their true rows (a
+  // synthetic camera's pitch jitters from frame to frame; its mounting is the median).
+  std::optional<double> camera_truth;
 };
 
 double Median(std::vector<double> v) {
@@ -54,8 +58,8 @@ nlohmann::json Summary(const std::vector<FrameHorizon>& frames, int camera_after
     ++found;
     found_rows.push_back(RowsAt1024(f.estimate.row, f.height));
     if (f.truth) frame_errors.push_back(RowsAt1024(std::abs(f.estimate.row - *f.truth), f.height));
-    if (f.truth && f.camera && static_cast<int>(i) + 1 >= camera_after)
-      camera_errors.push_back(RowsAt1024(std::abs(*f.camera - *f.truth), f.height));
+    if (f.camera_truth && f.camera && static_cast<int>(i) + 1 >= camera_after)
+      camera_errors.push_back(RowsAt1024(std::abs(*f.camera - *f.camera_truth), f.height));
   }
   nlohmann::json s = {{"frames", frames.size()},
                       {"found", found},
@@ -89,9 +93,10 @@ Runner AddHorizonCommand(CLI::App& app) {
     int camera_after = 20;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand(
-      "horizon", "the horizon row self-calibration estimates per frame, and its error on "
-                 "synthetic frames");
+  CLI::App* cmd =
+      app.add_subcommand("horizon",
+                         "the horizon row self-calibration estimates per frame, and its error on "
+                         "synthetic frames");
   cmd->add_option("--data", args->data.data.data_root, "dataset root (or give IMAGE files)");
   cmd->add_option("--format", args->data.data.format, "auto | laf | masks | modd2");
   cmd->add_option("--split", args->data.data.split, "split of --data (test)");
@@ -103,12 +108,14 @@ Runner AddHorizonCommand(CLI::App& app) {
   cmd->add_option("--json", args->json, "write every frame's estimate and the summary here");
   return [args] {
     std::vector<FrameHorizon> frames;
-    CameraHorizon camera;
+    CameraHorizon camera, camera_truth;
     const auto add = [&](const std::string& name, const cv::Mat3b& image,
                          std::optional<double> truth) {
-      FrameHorizon f{name, image.rows, EstimateHorizon(image), truth, std::nullopt};
+      FrameHorizon f{name, image.rows, EstimateHorizon(image), truth, std::nullopt, std::nullopt};
       if (f.estimate.found) camera.Add(f.estimate.row);
+      if (truth) camera_truth.Add(*truth);
       f.camera = camera.Estimate();
+      f.camera_truth = camera_truth.Estimate();
       frames.push_back(std::move(f));
     };
     if (!args->data.data.data_root.empty()) {
@@ -135,13 +142,17 @@ Runner AddHorizonCommand(CLI::App& app) {
       std::printf("%-40s %6s %9.1f %9.1f %7.1f %6.3f\n", f.name.c_str(),
                   f.estimate.found ? "yes" : "no", f.estimate.row, f.truth.value_or(NAN), err,
                   f.estimate.peak_share);
-      nlohmann::json j = {{"frame", f.name},      {"height", f.height},
-                          {"found", f.estimate.found}, {"row", f.estimate.row},
+      nlohmann::json j = {{"frame", f.name},
+                          {"height", f.height},
+                          {"found", f.estimate.found},
+                          {"row", f.estimate.row},
                           {"peak_share", f.estimate.peak_share},
-                          {"segments", f.estimate.segments}, {"peak_pairs", f.estimate.peak_pairs}};
+                          {"segments", f.estimate.segments},
+                          {"peak_pairs", f.estimate.peak_pairs}};
       if (!f.estimate.found) j["reason"] = f.estimate.reason;
       if (f.truth) j["truth"] = *f.truth;
       if (f.camera) j["camera"] = *f.camera;
+      if (f.camera_truth) j["camera_truth"] = *f.camera_truth;
       per_frame.push_back(j);
     }
     const nlohmann::json summary = Summary(frames, args->camera_after);

@@ -469,4 +469,28 @@ TEST_F(CliTest, AShiftedFrameKeepsTheObstacleFirstAndSaysHowFarTheHorizonMoved) 
   EXPECT_NEAR(horizon_rows[0] - horizon_rows[1], shift, 0.02 * frame.rows);
 }
 
+// `tod horizon` on a synthetic camera mounted low with a wide lens (horizon at 0.3 of the
+// height): per frame and per camera (the running median after 20 frames, against the median
+// true horizon of those frames) within the targets, 10 and 5 rows at 1024 rows.
+TEST_F(CliTest, HorizonReportsTheEstimatesErrorOnAnotherSyntheticCamera) {
+  CommandResult run = Shell(tod_ + " synth --out " + (out_ / "cam").string() +
+                            " --train 0 --test 24 --seed 21 --width 1024 --height 512"
+                            " --horizon-frac 0.30 --camera-height-m 1.0 --focal-frac 0.8");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string json = (out_ / "horizon.json").string();
+  run = Shell(tod_ + " horizon --data " + (out_ / "cam").string() + " --json " + json);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const nlohmann::json& summary = j["summary"];
+  EXPECT_EQ(summary["frames"], 24);
+  EXPECT_GE(summary["found_share"].get<double>(), 0.6) << summary.dump();
+  EXPECT_LE(summary["frame_error_median"].get<double>(), 10.0) << summary.dump();
+  EXPECT_EQ(summary["camera_after_frames"], 20);
+  EXPECT_LE(summary["camera_error_median"].get<double>(), 5.0) << summary.dump();
+  const nlohmann::json& last = j["frames"].back();
+  ASSERT_TRUE(last.contains("camera_truth")) << last.dump();
+  EXPECT_NEAR(last["camera_truth"].get<double>(), 0.30 * 512, 0.05 * 512) << last.dump();
+}
+
 }  // namespace
