@@ -1,6 +1,7 @@
 #include "core/calibration/horizon_choice.h"
 
 #include <cmath>
+#include <string>
 
 namespace tod {
 
@@ -44,9 +45,20 @@ HorizonUse ChooseHorizon(std::optional<double> bundle_row, int frame_height,
     use.fallback = frame.reason.empty() ? "no horizon estimate" : frame.reason;
     return use;
   }
-  if (use.source != HorizonSource::kCamera) use.source = HorizonSource::kFrame;
+  const double rows_per_1024 = frame_height / 1024.0;
+  double deadband = params.deadband_rows_at_1024 * rows_per_1024;
+  if (use.source != HorizonSource::kCamera) {
+    if (frame.peak_pairs < params.frame_min_peak_pairs) {
+      use.fallback = "a lone frame's estimate from " + std::to_string(frame.peak_pairs) +
+                     " agreeing pairs is too weak to move the geometry (" +
+                     std::to_string(params.frame_min_peak_pairs) +
+                     " needed; a camera_id accumulates one over its frames)";
+      return use;
+    }
+    use.source = HorizonSource::kFrame;
+    deadband = params.frame_deadband_rows_at_1024 * rows_per_1024;
+  }
   use.row = estimate;
-  const double deadband = params.deadband_rows_at_1024 * frame_height / 1024.0;
   if (std::abs(*estimate - *bundle_row) > deadband) use.shift = *estimate - *bundle_row;
   return use;
 }

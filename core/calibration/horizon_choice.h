@@ -32,6 +32,14 @@ struct HorizonChoiceParams {
   // An estimate this close to the bundle's reference leaves the geometry where it is, in rows
   // at a height of 1024 (the Lost and Found camera's own frames spread by a median 15 rows).
   double deadband_rows_at_1024 = 24;
+  // A lone frame (no camera) moves the geometry only when its own estimate is this far off the
+  // reference and that many pairs agree on it: one frame's estimate on the Lost and Found
+  // camera's own frames spreads by a median 10.7 rows (about 16 rows sigma: 3 sigma is 48), and
+  // its two estimates 87-90 rows off came from 21 and 23 pairs. Moved by the camera's deadband,
+  // 10 of its 100 frames were moved, and the 5-fold CV lost pixel AP on every fold
+  // (docs/findings.md, self-calibration).
+  double frame_deadband_rows_at_1024 = 48;
+  int frame_min_peak_pairs = 40;
 };
 
 // bundle_row: the bundle's reference mapped onto this frame (none: the bundle has no reference,

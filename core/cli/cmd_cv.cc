@@ -1,5 +1,5 @@
 // tod cv --data DIR --work DIR [--folds 5] [--seeds 1] [--seed S] [--paper NAME] [--json FILE]
-//        [--keep-models | --reuse-models] [--geometry frame|camera|bundle]
+//        [--keep-models | --reuse-models] [--test-data DIR] [--geometry frame|camera|bundle]
 // Cross-validates the training recipe (tod train's defaults) over K folds of consecutive frames
 // and N seeds (core/validation/cross_validation.h): trains on K-1 folds, evaluates on the one
 // left out, and prints the headline metrics per fold with their mean and min-max spread; the
@@ -52,6 +52,9 @@ Runner AddCvCommand(CLI::App& app) {
                 "evaluate the bundles --keep-models left under --work instead of training "
                 "(the same models under other detection options or evaluation code)")
       ->excludes("--keep-models");
+  cmd->add_option("--test-data", args->cv.test_data,
+                  "read each held-out fold's frames from this dataset root instead: the same "
+                  "frames made into another camera (tod reframe)");
   AddEvalGeometryOption(cmd, &args->eval.geometry);
   cmd->add_option("--json", args->json, "write every number under \"cv\" to this file");
   return [args] {

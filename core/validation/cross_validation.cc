@@ -129,6 +129,7 @@ Result<nlohmann::json> RunFold(const TrainOptions& recipe, const EvalOptions& ev
   if (!bundle.ok()) return bundle.status();
   EvalOptions test = eval;
   test.data = recipe.data;
+  if (!options.test_data.empty()) test.data.data_root = options.test_data;
   test.data.split = "test";
   test.data.split_file = split;
   auto report = EvaluateModel(*bundle, test);

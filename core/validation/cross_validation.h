@@ -32,6 +32,10 @@ struct CrossValidationOptions {
   // bundle is refused unless the split file kept beside it is this fold's and its manifest
   // names this data and seed.
   bool reuse_models = false;
+  // The held-out fold's frames are read from this dataset root instead of the training data's:
+  // the same frames (same names, same layout) made into another camera (tod reframe), tested
+  // with bundles trained on the originals. Empty: the training data.
+  std::string test_data;
   std::function<void(const std::string&)> progress;
 };
 

@@ -47,6 +47,7 @@ TEST(HorizonChoiceTest, CameraThenFrameThenBundle) {
   HorizonEstimate frame;
   frame.found = true;
   frame.row = 500;
+  frame.peak_pairs = 100;
   // No reference: the bundle's geometry, said why.
   HorizonUse use = ChooseHorizon(std::nullopt, 1024, frame, nullptr);
   EXPECT_EQ(use.source, HorizonSource::kBundle);
@@ -59,6 +60,21 @@ TEST(HorizonChoiceTest, CameraThenFrameThenBundle) {
   // Within the deadband: not moved.
   frame.row = 410;
   EXPECT_EQ(ChooseHorizon(400.0, 1024, frame, nullptr).shift, 0);
+  // A lone frame 40 rows off is within its own wider deadband; a camera's median is not.
+  frame.row = 440;
+  EXPECT_EQ(ChooseHorizon(400.0, 1024, frame, nullptr).shift, 0);
+  {
+    CameraTrack steady;
+    EXPECT_DOUBLE_EQ(ChooseHorizon(400.0, 1024, frame, &steady).shift, 40);
+  }
+  // A lone frame's estimate from too few agreeing pairs moves nothing, and says why.
+  frame.row = 500;
+  frame.peak_pairs = 20;
+  use = ChooseHorizon(400.0, 1024, frame, nullptr);
+  EXPECT_EQ(use.source, HorizonSource::kBundle);
+  EXPECT_EQ(use.shift, 0);
+  EXPECT_NE(use.fallback.find("pairs"), std::string::npos) << use.fallback;
+  frame.peak_pairs = 100;
   // A camera: the median of its frames, counted.
   CameraTrack camera;
   for (double row : {600.0, 600.0, 100.0}) {

@@ -643,6 +643,23 @@ TEST_F(MasksCliTest, CrossValidationOverFoldsOfConsecutiveFrames) {
     if (path.rfind("timing_ms/", 0) != 0) {
       EXPECT_EQ(r["mean"][path], value) << path;
     }
+  // The kept bundles tested on the same frames made into another camera, as that camera.
+  const std::string reframed = (out_ / "reframed").string();
+  const CommandResult made = RunCommand(tod_ + " reframe --data " + Root() + " --out " + reframed +
+                                        " --shift-up 0.1 --format jpg");
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const std::string camera_json = (out_ / "cv-camera.json").string();
+  const CommandResult camera = RunCommand(common + " --reuse-models --test-data " + reframed +
+                                          " --geometry camera --json " + camera_json);
+  ASSERT_EQ(camera.exit_code, 0) << camera.output;
+  std::ifstream camera_in(camera_json);
+  const nlohmann::json c = nlohmann::json::parse(camera_in)["cv"];
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(c["runs"][k][0]["frames"].get<int>(), frames[k][2].get<int>()) << k;
+    EXPECT_EQ(c["runs"][k][0]["geometry"]["mode"], "camera") << k;
+  }
+  EXPECT_GT(c["mean"]["geometry/median_abs_shift_rows"].get<double>(), 0.0) << c["mean"].dump();
+
   const CommandResult other_seed = RunCommand(common + " --seed 2 --reuse-models");
   EXPECT_NE(other_seed.exit_code, 0) << other_seed.output;
   EXPECT_NE(other_seed.output.find("--keep-models"), std::string::npos) << other_seed.output;
