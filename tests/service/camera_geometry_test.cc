@@ -19,6 +19,7 @@
 
 #include "client/tod_grpc_client.h"
 #include "tests/service/server_harness.h"
+#include "tests/service/shared_server_test.h"
 #include "tests/service/test_images.h"
 #include "tests/test_env.h"
 
@@ -66,22 +67,17 @@ tod::v1::DetectRequest Request(const std::string& image, const std::string& came
   return request;
 }
 
-class CameraGeometryTest : public ::testing::Test {
+class CameraGeometryTest : public testing::SharedServerTest<CameraGeometryTest> {
+ public:
+  // No frame budget: on a busy machine a degraded stage must not decide what is asserted.
+  static std::vector<std::string> ServerArgs() {
+    return {"--workers", "2", "--frame-budget-ms", "0"};
+  }
+
  protected:
-  static void SetUpTestSuite() {
-    if (TestModel().empty() || !fs::exists(testing::BinaryPath("tod_server"))) return;
-    // No frame budget: on a busy machine a degraded stage must not decide what is asserted.
-    server_ =
-        ServerProcess::Start(TestModel(), {"--workers", "2", "--frame-budget-ms", "0"}).release();
-    ready_ = server_->WaitReady();
-  }
-  static void TearDownTestSuite() {
-    delete server_;
-    server_ = nullptr;
-  }
   void SetUp() override {
-    REQUIRE_MODEL();
-    ASSERT_TRUE(ready_) << server_->Log();
+    SharedServerTest::SetUp();
+    if (HasFatalFailure()) return;
     frames_ = FixtureFrames();
     ASSERT_GE(frames_.size(), 4u) << "the fixture's test frames";
     frames_.resize(4);
@@ -90,8 +86,6 @@ class CameraGeometryTest : public ::testing::Test {
     grpc_ = std::make_unique<client::TodGrpcClient>(server_->grpc_address());
   }
 
-  static inline ServerProcess* server_ = nullptr;
-  static inline bool ready_ = false;
   std::vector<std::string> frames_;
   std::unique_ptr<httplib::Client> http_;
   std::unique_ptr<client::TodGrpcClient> grpc_;

@@ -16,6 +16,7 @@
 #include "client/tod_grpc_client.h"
 #include "tests/service/raw_http.h"
 #include "tests/service/server_harness.h"
+#include "tests/service/shared_server_test.h"
 #include "tests/service/test_images.h"
 
 namespace tod::server {
@@ -30,9 +31,13 @@ using testing::TestModel;
 
 constexpr uint64_t kMiB = 1u << 20;
 
-std::unique_ptr<ServerProcess> StartServer(std::vector<std::string> args) {
+std::vector<std::string> ServerArgsWith(std::vector<std::string> args) {
   args.insert(args.end(), {"--workers", "2", "--log-format", "json"});
-  return ServerProcess::Start(TestModel(), args);
+  return args;
+}
+
+std::unique_ptr<ServerProcess> StartServer(std::vector<std::string> args) {
+  return ServerProcess::Start(TestModel(), ServerArgsWith(std::move(args)));
 }
 
 double Refused(int http_port, const std::string& reason) {
@@ -78,27 +83,20 @@ std::string JpegClaiming(int width, int height) {
   return jpeg;
 }
 
-class HttpHardeningTest : public ::testing::Test {
+class HttpHardeningTest : public testing::SharedServerTest<HttpHardeningTest> {
+ public:
+  // The default limits: they are what is being tested.
+  static std::vector<std::string> ServerArgs() { return ServerArgsWith({}); }
+
  protected:
-  static void SetUpTestSuite() {
-    if (TestModel().empty() || !std::filesystem::exists(testing::BinaryPath("tod_server"))) return;
-    server_ = StartServer({}).release();  // default limits: they are what is being tested
-    ready_ = server_->WaitReady();
-  }
-  static void TearDownTestSuite() {
-    delete server_;
-    server_ = nullptr;
-  }
   void SetUp() override {
-    REQUIRE_MODEL();
-    ASSERT_TRUE(ready_) << server_->Log();
+    SharedServerTest::SetUp();
+    if (HasFatalFailure()) return;
     http_ = std::make_unique<httplib::Client>("127.0.0.1", server_->http_port());
     http_->set_read_timeout(60s);
   }
   int port() const { return server_->http_port(); }
 
-  static inline ServerProcess* server_ = nullptr;
-  static inline bool ready_ = false;
   std::unique_ptr<httplib::Client> http_;
 };
 

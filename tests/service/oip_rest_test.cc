@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "tests/service/server_harness.h"
+#include "tests/service/shared_server_test.h"
 #include "tests/service/test_images.h"
 
 namespace tod::server {
@@ -205,24 +206,15 @@ std::vector<float> JsonFloats(const json& data) {
   return out;
 }
 
-class OipRestTest : public ::testing::Test {
+class OipRestTest : public testing::SharedServerTest<OipRestTest> {
+ public:
+  static std::vector<std::string> ServerArgs() {
+    return {"--workers",          "2",
+            "--max-image-bytes",  std::to_string(kMaxBytes),
+            "--max-image-pixels", std::to_string(kMaxPixels)};
+  }
+
  protected:
-  static void SetUpTestSuite() {
-    if (TestModel().empty() || !fs::exists(testing::BinaryPath("tod_server"))) return;
-    server_ = ServerProcess::Start(
-                  TestModel(), {"--workers", "2", "--max-image-bytes", std::to_string(kMaxBytes),
-                                "--max-image-pixels", std::to_string(kMaxPixels)})
-                  .release();
-    ready_ = server_->WaitReady();
-  }
-  static void TearDownTestSuite() {
-    delete server_;
-    server_ = nullptr;
-  }
-  void SetUp() override {
-    REQUIRE_MODEL();
-    ASSERT_TRUE(ready_) << server_->Log();
-  }
   int port() const { return server_->http_port(); }
   std::string ModelPath(const std::string& rest = "") const {
     return "/v2/models/" + ModelName() + rest;
@@ -234,9 +226,6 @@ class OipRestTest : public ::testing::Test {
     EXPECT_EQ(v1.status, 200) << v1.output << v1.body;
     return v1.status == 200 ? json::parse(v1.body) : json();
   }
-
-  static inline ServerProcess* server_ = nullptr;
-  static inline bool ready_ = false;
 };
 
 TEST_F(OipRestTest, ServerAndModelMetadata) {

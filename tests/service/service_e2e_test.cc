@@ -18,6 +18,7 @@
 
 #include "client/tod_grpc_client.h"
 #include "tests/service/server_harness.h"
+#include "tests/service/shared_server_test.h"
 #include "tests/service/test_images.h"
 #include "tests/test_env.h"
 
@@ -55,24 +56,25 @@ std::string ErrorMessage(const httplib::Result& result) {
 }
 
 // One server shared by the functional tests of this suite.
-class ServiceE2ETest : public ::testing::Test {
+class ServiceE2ETest : public testing::SharedServerTest<ServiceE2ETest> {
+ public:
+  static std::vector<std::string> ServerArgs() {
+    return {"--workers",
+            "2",
+            "--queue",
+            "16",
+            "--max-image-bytes",
+            std::to_string(kMaxBytes),
+            "--max-image-pixels",
+            std::to_string(kMaxPixels),
+            "--log-format",
+            "json"};
+  }
+
  protected:
-  static void SetUpTestSuite() {
-    if (TestModel().empty() || !fs::exists(testing::BinaryPath("tod_server"))) return;
-    server_ =
-        ServerProcess::Start(TestModel(), {"--workers", "2", "--queue", "16", "--max-image-bytes",
-                                           std::to_string(kMaxBytes), "--max-image-pixels",
-                                           std::to_string(kMaxPixels), "--log-format", "json"})
-            .release();
-    ready_ = server_->WaitReady();
-  }
-  static void TearDownTestSuite() {
-    delete server_;
-    server_ = nullptr;
-  }
   void SetUp() override {
-    REQUIRE_MODEL();
-    ASSERT_TRUE(ready_) << server_->Log();
+    SharedServerTest::SetUp();
+    if (HasFatalFailure()) return;
     http_ = std::make_unique<httplib::Client>("127.0.0.1", server_->http_port());
     http_->set_read_timeout(60s);
     grpc_ = std::make_unique<client::TodGrpcClient>(server_->grpc_address());
@@ -86,8 +88,6 @@ class ServiceE2ETest : public ::testing::Test {
     EXPECT_EQ(live->status, 200);
   }
 
-  static inline ServerProcess* server_ = nullptr;
-  static inline bool ready_ = false;
   std::unique_ptr<httplib::Client> http_;
   std::unique_ptr<client::TodGrpcClient> grpc_;
 };
